@@ -1,0 +1,46 @@
+# Remora's two entry points: `make demo` and `make test`. Both install what is missing
+# (scripts/bootstrap.sh), configure and build.
+BUILD      ?= build
+ASAN_BUILD ?= build-asan
+JOBS       ?= $(shell nproc)
+CMAKE_FLAGS ?=
+DEMO_MESH  ?= data/bunny.ply
+
+.PHONY: all deps build demo test test-release test-asan format format-check clean
+
+all: build
+
+deps:
+	@scripts/bootstrap.sh
+
+build: deps
+	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release -DREMORA_WERROR=ON $(CMAKE_FLAGS)
+	cmake --build $(BUILD) -j$(JOBS)
+
+demo: build
+	$(BUILD)/bin/remora info $(DEMO_MESH)
+
+# Release build with warnings as errors, the formatting check, then the unit tests again under
+# AddressSanitizer + UndefinedBehaviorSanitizer.
+test: deps format-check test-release test-asan
+
+test-release: build
+	cd $(BUILD) && ctest --output-on-failure -j$(JOBS)
+
+test-asan: deps
+	cmake -S . -B $(ASAN_BUILD) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DREMORA_WERROR=ON \
+	  -DREMORA_SANITIZE=ON -DREMORA_BUILD_BENCH=OFF $(CMAKE_FLAGS)
+	cmake --build $(ASAN_BUILD) -j$(JOBS)
+	cd $(ASAN_BUILD) && REMORA_SANITIZED=1 ASAN_OPTIONS=detect_leaks=1 \
+	  UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 ctest --output-on-failure -j$(JOBS)
+
+FORMAT_FILES = $(shell git ls-files '*.h' '*.cpp')
+
+format:
+	clang-format -i $(FORMAT_FILES)
+
+format-check:
+	@clang-format --dry-run --Werror $(FORMAT_FILES) && echo "format-check: clean"
+
+clean:
+	rm -rf $(BUILD) $(ASAN_BUILD)

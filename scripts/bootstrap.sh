@@ -1,0 +1,34 @@
+#!/usr/bin/env bash
+# Installs the Debian packages Remora builds and tests with, if any is missing.
+# As root it runs apt-get; otherwise it prints the exact command and stops (exit 1).
+set -euo pipefail
+
+packages=(
+  build-essential cmake pkg-config clang-format
+  libopenmesh-dev libeigen3-dev
+  libsuitesparse-dev libmetis-dev libopenblas-dev
+  libcli11-dev nlohmann-json3-dev libspdlog-dev libfmt-dev libcpp-httplib-dev
+  libgtest-dev libgmock-dev libbenchmark-dev
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  exit 0
+fi
+
+echo "bootstrap: missing Debian packages: ${missing[*]}"
+if [ "$(id -u)" -eq 0 ]; then
+  export DEBIAN_FRONTEND=noninteractive
+  apt-get update -qq
+  apt-get install -y -qq --no-install-recommends "${missing[@]}"
+else
+  echo "bootstrap: run this as root, then run make again:"
+  echo "  sudo apt-get update && sudo apt-get install -y --no-install-recommends ${missing[*]}"
+  exit 1
+fi

@@ -1,0 +1,593 @@
+#include "remora/mesh/repair.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstring>
+#include <limits>
+#include <numeric>
+#include <unordered_map>
+#include <unordered_set>
+
+#include "remora/common/error.h"
+
+namespace remora {
+
+namespace {
+
+using Tri = std::array<std::uint32_t, 3>;
+
+struct PointKey {
+  double x, y, z;
+  bool operator==(const PointKey& o) const { return x == o.x && y == o.y && z == o.z; }
+};
+
+struct PointKeyHash {
+  std::size_t operator()(const PointKey& k) const {
+    auto h = [](double d) {
+      std::uint64_t u;
+      static_assert(sizeof(u) == sizeof(d));
+      std::memcpy(&u, &d, sizeof(u));
+      return u;
+    };
+    std::uint64_t s = h(k.x) * 0x9E3779B97F4A7C15ULL;
+    s ^= h(k.y) + 0x7F4A7C159E3779B9ULL + (s << 6) + (s >> 2);
+    s ^= h(k.z) + 0x94D049BB133111EBULL + (s << 6) + (s >> 2);
+    return static_cast<std::size_t>(s ^ (s >> 31));
+  }
+};
+
+// -0.0 and +0.0 are the same point.
+PointKey key_of(const Vec3& p) {
+  return {p[0] + 0.0, p[1] + 0.0, p[2] + 0.0};
+}
+
+struct TriHash {
+  std::size_t operator()(const Tri& t) const {
+    std::uint64_t s = (std::uint64_t(t[0]) << 32 | t[1]) * 0x9E3779B97F4A7C15ULL;
+    s ^= t[2] * 0xBF58476D1CE4E5B9ULL;
+    return static_cast<std::size_t>(s ^ (s >> 29));
+  }
+};
+
+// Ear clipping of one planar-ish polygon, in its best-fit (Newell) plane. Keeps the polygon's
+// winding. Falls back to clipping the flattest corner when no proper ear exists (self-overlapping
+// or degenerate input), so it always produces n-2 triangles.
+void triangulate_polygon(const std::vector<Vec3>& pts, const std::vector<std::uint32_t>& poly,
+                         std::vector<Tri>& out) {
+  const std::size_t n = poly.size();
+  if (n == 3) {
+    out.push_back({poly[0], poly[1], poly[2]});
+    return;
+  }
+  Vec3 normal(0, 0, 0);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Vec3& a = pts[poly[i]];
+    const Vec3& b = pts[poly[(i + 1) % n]];
+    normal[0] += (a[1] - b[1]) * (a[2] + b[2]);
+    normal[1] += (a[2] - b[2]) * (a[0] + b[0]);
+    normal[2] += (a[0] - b[0]) * (a[1] + b[1]);
+  }
+  // Drop the dominant axis of the normal; the 2D polygon then has the sign of that component.
+  int axis = 0;
+  for (int k = 1; k < 3; ++k)
+    if (std::abs(normal[k]) > std::abs(normal[axis])) axis = k;
+  const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+  const double sign = normal[axis] >= 0 ? 1.0 : -1.0;
+  std::vector<std::array<double, 2>> p2(n);
+  for (std::size_t i = 0; i < n; ++i) p2[i] = {pts[poly[i]][u], sign * pts[poly[i]][v]};
+
+  auto cross = [&](std::size_t a, std::size_t b, std::size_t c) {
+    return (p2[b][0] - p2[a][0]) * (p2[c][1] - p2[a][1]) -
+           (p2[b][1] - p2[a][1]) * (p2[c][0] - p2[a][0]);
+  };
+  std::vector<std::size_t> ring(n);
+  std::iota(ring.begin(), ring.end(), std::size_t{0});
+  while (ring.size() > 3) {
+    const std::size_t m = ring.size();
+    std::size_t best = m; // index in ring of the ear to clip
+    double best_fallback = -std::numeric_limits<double>::infinity();
+    std::size_t fallback = 0;
+    for (std::size_t i = 0; i < m && best == m; ++i) {
+      const std::size_t a = ring[(i + m - 1) % m], b = ring[i], c = ring[(i + 1) % m];
+      const double turn = cross(a, b, c);
+      if (turn > best_fallback) {
+        best_fallback = turn;
+        fallback = i;
+      }
+      if (turn <= 0) continue; // reflex or flat corner
+      bool empty = true;
+      for (std::size_t j = 0; j < m && empty; ++j) {
+        const std::size_t q = ring[j];
+        if (q == a || q == b || q == c) continue;
+        if (cross(a, b, q) >= 0 && cross(b, c, q) >= 0 && cross(c, a, q) >= 0) empty = false;
+      }
+      if (empty) best = i;
+    }
+    if (best == m) best = fallback;
+    const std::size_t a = ring[(best + m - 1) % m], b = ring[best], c = ring[(best + 1) % m];
+    out.push_back({poly[a], poly[b], poly[c]});
+    ring.erase(ring.begin() + static_cast<std::ptrdiff_t>(best));
+  }
+  out.push_back({poly[ring[0]], poly[ring[1]], poly[ring[2]]});
+}
+
+struct DisjointSets {
+  std::vector<std::uint32_t> parent;
+  explicit DisjointSets(std::size_t n) : parent(n) {
+    std::iota(parent.begin(), parent.end(), std::uint32_t{0});
+  }
+  std::uint32_t find(std::uint32_t x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  }
+  void unite(std::uint32_t a, std::uint32_t b) {
+    a = find(a);
+    b = find(b);
+    if (a != b) parent[std::max(a, b)] = std::min(a, b);
+  }
+};
+
+// One side of an undirected edge: triangle t uses the edge starting at its corner k, i.e. the
+// directed edge tri[t][k] -> tri[t][(k+1)%3].
+struct EdgeSide {
+  std::uint64_t key; // (min << 32) | max
+  std::uint32_t tri;
+  std::uint8_t corner;
+};
+
+std::uint64_t edge_key(std::uint32_t a, std::uint32_t b) {
+  return a < b ? (std::uint64_t(a) << 32 | b) : (std::uint64_t(b) << 32 | a);
+}
+
+class SoupRepairer {
+public:
+  SoupRepairer(const PolygonSoup& soup, const RepairOptions& options)
+      : soup_(soup), options_(options) {}
+
+  RepairResult run() {
+    report_.vertices_in = soup_.points.size();
+    report_.polygons_in = soup_.num_polygons();
+    check_indices();
+    weld();
+    triangulate();
+    drop_degenerate_and_duplicates();
+    build_edge_sides();
+    if (options_.orient) orient();
+    split_nonmanifold();
+    detach_conflicts_and_resplit();
+    return build();
+  }
+
+private:
+  void check_indices() {
+    const std::size_t nv = soup_.points.size();
+    for (std::size_t f = 0; f < soup_.num_polygons(); ++f)
+      for (std::uint32_t i = soup_.offsets[f]; i < soup_.offsets[f + 1]; ++i)
+        if (soup_.indices[i] >= nv)
+          throw InvalidArgument("polygon " + std::to_string(f) + " references vertex " +
+                                std::to_string(soup_.indices[i]) + " but the soup has only " +
+                                std::to_string(nv) + " vertices");
+  }
+
+  // Steps 1 and 2: unreferenced vertices are dropped, coincident ones merged. vmap_ maps soup
+  // vertex -> welded vertex (or kNone when unreferenced).
+  void weld() {
+    const std::size_t nv = soup_.points.size();
+    std::vector<char> used(nv, 0);
+    for (std::uint32_t i : soup_.indices) used[i] = 1;
+    vmap_.assign(nv, kNone);
+    std::unordered_map<PointKey, std::uint32_t, PointKeyHash> first;
+    if (options_.weld) first.reserve(nv);
+    for (std::size_t i = 0; i < nv; ++i) {
+      if (!used[i]) {
+        ++report_.unreferenced_vertices;
+        continue;
+      }
+      if (options_.weld) {
+        auto [it, inserted] =
+            first.try_emplace(key_of(soup_.points[i]), static_cast<std::uint32_t>(points_.size()));
+        if (!inserted) {
+          vmap_[i] = it->second;
+          ++report_.welded_vertices;
+          continue;
+        }
+      }
+      vmap_[i] = static_cast<std::uint32_t>(points_.size());
+      points_.push_back(soup_.points[i]);
+      source_.push_back(static_cast<std::uint32_t>(i));
+    }
+  }
+
+  // Step 3.
+  void triangulate() {
+    tris_.reserve(soup_.indices.size() / 3 + 1);
+    std::vector<std::uint32_t> poly;
+    for (std::size_t f = 0; f < soup_.num_polygons(); ++f) {
+      const std::size_t n = soup_.polygon_size(f);
+      if (n < 3) {
+        ++report_.dropped_degenerate_polygon;
+        continue;
+      }
+      poly.clear();
+      for (std::uint32_t i = soup_.offsets[f]; i < soup_.offsets[f + 1]; ++i)
+        poly.push_back(vmap_[soup_.indices[i]]);
+      if (n > 3) {
+        ++report_.polygons_triangulated;
+        report_.triangles_added_by_triangulation += n - 3;
+      }
+      triangulate_polygon(points_, poly, tris_);
+    }
+  }
+
+  // Step 4.
+  void drop_degenerate_and_duplicates() {
+    std::unordered_set<Tri, TriHash> seen;
+    seen.reserve(tris_.size());
+    std::size_t out = 0;
+    for (const Tri& t : tris_) {
+      if (t[0] == t[1] || t[1] == t[2] || t[2] == t[0]) {
+        ++report_.dropped_repeated_vertex;
+        continue;
+      }
+      Tri sorted = t;
+      std::sort(sorted.begin(), sorted.end());
+      if (!seen.insert(sorted).second) {
+        ++report_.dropped_duplicate;
+        continue;
+      }
+      tris_[out++] = t;
+    }
+    tris_.resize(out);
+  }
+
+  void build_edge_sides() {
+    sides_.clear();
+    sides_.reserve(tris_.size() * 3);
+    for (std::uint32_t t = 0; t < tris_.size(); ++t)
+      for (std::uint8_t k = 0; k < 3; ++k)
+        sides_.push_back({edge_key(tris_[t][k], tris_[t][(k + 1) % 3]), t, k});
+    std::sort(sides_.begin(), sides_.end(), [](const EdgeSide& a, const EdgeSide& b) {
+      return a.key != b.key ? a.key < b.key : a.tri < b.tri;
+    });
+    group_start_.clear();
+    for (std::size_t i = 0; i < sides_.size(); ++i)
+      if (i == 0 || sides_[i].key != sides_[i - 1].key)
+        group_start_.push_back(static_cast<std::uint32_t>(i));
+    group_start_.push_back(static_cast<std::uint32_t>(sides_.size()));
+  }
+
+  // Does the side run from the smaller to the larger vertex id (with the current winding)?
+  bool forward(const EdgeSide& s) const {
+    const Tri& t = tris_[s.tri];
+    return t[s.corner] < t[(s.corner + 1) % 3];
+  }
+
+  // Step 5: breadth-first propagation over edges shared by exactly two triangles.
+  void orient() {
+    const std::size_t nt = tris_.size();
+    // Adjacency over two-sided edges: for each triangle its up to three neighbours, and whether
+    // the neighbour currently runs the shared edge the same way (which calls for a flip).
+    std::vector<std::array<std::uint32_t, 3>> nbr(nt, {kNone, kNone, kNone});
+    std::vector<std::array<char, 3>> same(nt, {0, 0, 0});
+    std::vector<char> open_edge(nt, 0);
+    for (std::size_t g = 0; g + 1 < group_start_.size(); ++g) {
+      const std::uint32_t b = group_start_[g], e = group_start_[g + 1];
+      if (e - b != 2) {
+        for (std::uint32_t i = b; i < e; ++i) open_edge[sides_[i].tri] = 1;
+        continue;
+      }
+      const EdgeSide &s0 = sides_[b], &s1 = sides_[b + 1];
+      const char sd = forward(s0) == forward(s1);
+      nbr[s0.tri][s0.corner] = s1.tri;
+      same[s0.tri][s0.corner] = sd;
+      nbr[s1.tri][s1.corner] = s0.tri;
+      same[s1.tri][s1.corner] = sd;
+    }
+    std::vector<char> flip(nt, 0), visited(nt, 0);
+    std::vector<std::uint32_t> queue, component;
+    for (std::uint32_t seed = 0; seed < nt; ++seed) {
+      if (visited[seed]) continue;
+      component.clear();
+      queue.assign(1, seed);
+      visited[seed] = 1;
+      bool closed = true;
+      while (!queue.empty()) {
+        const std::uint32_t t = queue.back();
+        queue.pop_back();
+        component.push_back(t);
+        if (open_edge[t]) closed = false;
+        for (int k = 0; k < 3; ++k) {
+          const std::uint32_t u = nbr[t][k];
+          if (u == kNone) {
+            closed = false;
+            continue;
+          }
+          if (visited[u]) continue;
+          visited[u] = 1;
+          flip[u] = static_cast<char>(flip[t] ^ same[t][k]);
+          queue.push_back(u);
+        }
+      }
+      // Choose the component's global sign: outward for closed components, the file's majority
+      // winding for open ones.
+      bool invert;
+      if (closed && options_.outward) {
+        double volume = 0;
+        for (std::uint32_t t : component) {
+          const Tri& tri = tris_[t];
+          const Vec3 &a = points_[tri[0]], &b = points_[tri[1]], &c = points_[tri[2]];
+          const double v = OpenMesh::dot(a, OpenMesh::cross(b, c));
+          volume += flip[t] ? -v : v;
+        }
+        invert = volume < 0;
+      } else {
+        std::size_t flipped = 0;
+        for (std::uint32_t t : component) flipped += flip[t] ? 1 : 0;
+        invert = 2 * flipped > component.size();
+      }
+      for (std::uint32_t t : component) {
+        if (invert) flip[t] ^= 1;
+        if (flip[t]) {
+          std::swap(tris_[t][1], tris_[t][2]);
+          ++report_.flipped_faces;
+        }
+      }
+    }
+    // The sides' corners refer to the old winding; rebuild them.
+    build_edge_sides();
+  }
+
+  // Step 6: decide which triangle pairs are joined across each edge, then give every fan of
+  // joined triangles around a vertex its own copy of that vertex.
+  void split_nonmanifold() {
+    const std::size_t nt = tris_.size();
+    DisjointSets corners(nt * 3); // corner id = 3*t + k
+    auto corner_of = [&](std::uint32_t t, std::uint32_t v) {
+      const Tri& tri = tris_[t];
+      const std::uint32_t k = tri[0] == v ? 0 : (tri[1] == v ? 1 : 2);
+      return 3 * t + k;
+    };
+    auto join = [&](const EdgeSide& a, const EdgeSide& b) {
+      const Tri& ta = tris_[a.tri];
+      const std::uint32_t v0 = ta[a.corner], v1 = ta[(a.corner + 1) % 3];
+      corners.unite(corner_of(a.tri, v0), corner_of(b.tri, v0));
+      corners.unite(corner_of(a.tri, v1), corner_of(b.tri, v1));
+    };
+    struct Around {
+      double angle;       // around the edge, from the first side
+      std::uint32_t side; // index into sides_
+      bool behind_ccw;    // the sector towards the next side counter-clockwise is behind the face
+    };
+    std::vector<Around> around;
+    for (std::size_t g = 0; g + 1 < group_start_.size(); ++g) {
+      const std::uint32_t b = group_start_[g], e = group_start_[g + 1];
+      if (e - b == 1) continue;
+      if (e - b == 2) {
+        if (forward(sides_[b]) != forward(sides_[b + 1]))
+          join(sides_[b], sides_[b + 1]);
+        else
+          ++report_.orientation_cuts;
+        continue;
+      }
+      // More than two triangles on one edge: order them by their angle around the edge and join
+      // angular neighbours of opposite direction, first across the sectors that lie behind both
+      // faces (inside a solid: two closed bodies touching along an edge stay two closed bodies),
+      // then any remaining neighbours; the rest are cut apart.
+      ++report_.nonmanifold_edges;
+      const std::uint64_t key = sides_[b].key;
+      const std::uint32_t va = static_cast<std::uint32_t>(key >> 32);
+      const std::uint32_t vb = static_cast<std::uint32_t>(key & 0xffffffffu);
+      const Vec3 axis = points_[vb] - points_[va];
+      const double axis2 = OpenMesh::dot(axis, axis);
+      Vec3 ref(0, 0, 0);
+      around.clear();
+      for (std::uint32_t i = b; i < e; ++i) {
+        const Tri& t = tris_[sides_[i].tri];
+        const std::uint32_t apex = t[(sides_[i].corner + 2) % 3];
+        Vec3 d = points_[apex] - points_[va];
+        if (axis2 > 0) d -= axis * (OpenMesh::dot(d, axis) / axis2);
+        if (i == b) ref = d;
+        const double angle =
+            std::atan2(OpenMesh::dot(OpenMesh::cross(ref, d), axis), OpenMesh::dot(ref, d));
+        const Vec3 normal =
+            OpenMesh::cross(points_[t[1]] - points_[t[0]], points_[t[2]] - points_[t[0]]);
+        const bool behind_ccw = OpenMesh::dot(normal, OpenMesh::cross(axis, d)) < 0;
+        around.push_back({angle, i, behind_ccw});
+      }
+      std::sort(around.begin(), around.end(),
+                [](const Around& x, const Around& y) { return x.angle < y.angle; });
+      const std::size_t m = around.size();
+      std::vector<char> paired(m, 0);
+      for (int pass = 0; pass < 2; ++pass)
+        for (std::size_t i = 0; i < m; ++i) {
+          const std::size_t j = (i + 1) % m;
+          if (paired[i] || paired[j] || (pass == 0 && !around[i].behind_ccw)) continue;
+          const EdgeSide &si = sides_[around[i].side], &sj = sides_[around[j].side];
+          if (forward(si) != forward(sj)) {
+            join(si, sj);
+            paired[i] = paired[j] = 1;
+          }
+        }
+    }
+    out_points_ = points_;
+    out_source_ = source_;
+    vertex_taken_.assign(points_.size(), 0);
+    assign_vertices(corners);
+  }
+
+  // Each class of corners around a vertex becomes one output vertex: the first class keeps the
+  // vertex, every further class gets a copy.
+  void assign_vertices(DisjointSets& corners) {
+    const std::size_t nt = tris_.size();
+    std::vector<std::uint32_t> class_vertex(nt * 3, kNone);
+    std::fill(vertex_taken_.begin(), vertex_taken_.end(), 0);
+    for (std::uint32_t t = 0; t < nt; ++t) {
+      for (std::uint32_t k = 0; k < 3; ++k) {
+        std::uint32_t& cv = class_vertex[corners.find(3 * t + k)];
+        if (cv == kNone) {
+          const std::uint32_t v = tris_[t][k];
+          if (!vertex_taken_[v]) {
+            vertex_taken_[v] = 1;
+            cv = v;
+          } else {
+            cv = add_copy(v);
+            vertex_taken_[cv] = 1;
+          }
+        }
+        tris_[t][k] = cv;
+      }
+    }
+  }
+
+  std::uint32_t add_copy(std::uint32_t v) {
+    const std::uint32_t copy = static_cast<std::uint32_t>(out_points_.size());
+    out_points_.push_back(out_points_[v]);
+    out_source_.push_back(out_source_[v]);
+    copy_of_.push_back(origin_of(v));
+    vertex_taken_.push_back(0);
+    return copy;
+  }
+
+  // The welded vertex a (possibly copied) vertex stems from.
+  std::uint32_t origin_of(std::uint32_t v) const {
+    return v < points_.size() ? v : copy_of_[v - points_.size()];
+  }
+
+  // A triangle whose directed edge another triangle already runs (possible only in tangled
+  // non-manifold configurations) gets vertex copies of its own; then every vertex is split once
+  // more into the fans of triangles that now actually share edges, so that each output vertex has
+  // exactly one fan and the half-edge structure is well defined.
+  void detach_conflicts_and_resplit() {
+    std::unordered_set<std::uint64_t> directed;
+    directed.reserve(tris_.size() * 3);
+    for (Tri& t : tris_) {
+      bool free = true;
+      for (int k = 0; k < 3; ++k)
+        free = free && !directed.count(std::uint64_t(t[k]) << 32 | t[(k + 1) % 3]);
+      if (free) {
+        for (int k = 0; k < 3; ++k) directed.insert(std::uint64_t(t[k]) << 32 | t[(k + 1) % 3]);
+        continue;
+      }
+      ++report_.faces_detached;
+      for (int k = 0; k < 3; ++k) t[k] = add_copy(t[k]);
+    }
+    build_edge_sides();
+    DisjointSets corners(tris_.size() * 3);
+    for (std::size_t g = 0; g + 1 < group_start_.size(); ++g) {
+      const std::uint32_t b = group_start_[g], e = group_start_[g + 1];
+      if (e - b != 2) continue; // directed edges are unique now: two sides are opposite
+      const EdgeSide &s0 = sides_[b], &s1 = sides_[b + 1];
+      // s1 runs the edge backwards: its corner k+1 holds s0's corner k vertex and vice versa.
+      corners.unite(3 * s0.tri + s0.corner, 3 * s1.tri + (s1.corner + 1u) % 3);
+      corners.unite(3 * s0.tri + (s0.corner + 1u) % 3, 3 * s1.tri + s1.corner);
+    }
+    assign_vertices(corners);
+  }
+
+  // Builds the half-edge structure directly (every vertex has one fan, every directed edge one
+  // triangle), which never fails and is faster than incremental add_face().
+  RepairResult build() {
+    RepairResult result;
+    Mesh& mesh = result.mesh;
+    std::vector<VertexHandle> handle(out_points_.size());
+    std::vector<std::uint32_t> copies(points_.size(), 0); // output vertices per welded vertex
+    for (std::size_t v = 0; v < out_points_.size(); ++v) {
+      if (!vertex_taken_[v]) continue;
+      handle[v] = mesh.new_vertex(out_points_[v]);
+      result.source_vertex.push_back(out_source_[v]);
+      ++copies[origin_of(static_cast<std::uint32_t>(v))];
+    }
+    for (std::uint32_t c : copies) {
+      if (c == 0) ++report_.orphaned_vertices; // every triangle it had was dropped
+      if (c > 1) {
+        ++report_.split_vertices;
+        report_.vertices_added_by_split += c - 1;
+      }
+    }
+    std::unordered_map<std::uint64_t, HalfedgeHandle> edge; // (min,max) -> halfedge min -> max
+    edge.reserve(tris_.size() * 2);
+    for (const Tri& t : tris_) {
+      const FaceHandle fh = mesh.new_face();
+      HalfedgeHandle hs[3];
+      for (int k = 0; k < 3; ++k) {
+        const std::uint32_t a = t[k], b = t[(k + 1) % 3];
+        auto [it, inserted] = edge.try_emplace(edge_key(a, b));
+        if (inserted)
+          it->second = a < b ? mesh.new_edge(handle[a], handle[b])
+                             : mesh.opposite_halfedge_handle(mesh.new_edge(handle[a], handle[b]));
+        hs[k] = a < b ? it->second : mesh.opposite_halfedge_handle(it->second);
+        mesh.set_face_handle(hs[k], fh);
+        mesh.set_halfedge_handle(handle[a], hs[k]);
+      }
+      for (int k = 0; k < 3; ++k) mesh.set_next_halfedge_handle(hs[k], hs[(k + 1) % 3]);
+      mesh.set_halfedge_handle(fh, hs[0]);
+    }
+    // Boundary halfedges: each vertex has at most one outgoing one, which follows the incoming
+    // one around the hole. A boundary vertex's halfedge is its outgoing boundary halfedge
+    // (OpenMesh's convention, which its boundary queries rely on).
+    std::vector<HalfedgeHandle> boundary_out(mesh.n_vertices());
+    for (auto h : mesh.halfedges())
+      if (mesh.is_boundary(h)) {
+        HalfedgeHandle& slot = boundary_out[mesh.from_vertex_handle(h).idx()];
+        if (slot.is_valid()) throw Error("internal error: a repaired vertex has two fans");
+        slot = h;
+      }
+    for (auto h : mesh.halfedges())
+      if (mesh.is_boundary(h))
+        mesh.set_next_halfedge_handle(h, boundary_out[mesh.to_vertex_handle(h).idx()]);
+    for (auto v : mesh.vertices())
+      if (boundary_out[v.idx()].is_valid()) mesh.set_halfedge_handle(v, boundary_out[v.idx()]);
+
+    report_.vertices_loaded = mesh.n_vertices();
+    report_.faces_loaded = mesh.n_faces();
+    report_.zero_area_faces = count_zero_area_faces(mesh);
+    result.report = report_;
+    return result;
+  }
+
+  static constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
+
+  const PolygonSoup& soup_;
+  const RepairOptions& options_;
+  RepairReport report_;
+  std::vector<std::uint32_t> vmap_;
+  std::vector<Vec3> points_;          // welded, referenced vertices
+  std::vector<std::uint32_t> source_; // their soup vertex
+  std::vector<Tri> tris_;
+  std::vector<EdgeSide> sides_;
+  std::vector<std::uint32_t> group_start_;
+  std::vector<Vec3> out_points_;
+  std::vector<std::uint32_t> out_source_;
+  std::vector<char> vertex_taken_;     // output vertex used by a triangle
+  std::vector<char> vertex_split_;     // welded vertex was split
+  std::vector<std::uint32_t> copy_of_; // for copies (index - points_.size()): the welded vertex
+};
+
+} // namespace
+
+std::size_t count_zero_area_faces(const Mesh& mesh) {
+  if (mesh.n_faces() == 0) return 0;
+  Vec3 lo(std::numeric_limits<double>::infinity()), hi(-std::numeric_limits<double>::infinity());
+  for (auto v : mesh.vertices()) {
+    lo.minimize(mesh.point(v));
+    hi.maximize(mesh.point(v));
+  }
+  const double diag2 = (hi - lo).sqrnorm();
+  std::size_t count = 0;
+  for (auto f : mesh.faces()) {
+    auto h = mesh.halfedge_handle(f);
+    const Vec3& a = mesh.point(mesh.from_vertex_handle(h));
+    const Vec3& b = mesh.point(mesh.to_vertex_handle(h));
+    const Vec3& c = mesh.point(mesh.to_vertex_handle(mesh.next_halfedge_handle(h)));
+    const double area = 0.5 * OpenMesh::cross(b - a, c - a).norm();
+    if (area <= kZeroAreaRelative * diag2) ++count;
+  }
+  return count;
+}
+
+RepairResult repair_soup(const PolygonSoup& soup, const RepairOptions& options) {
+  return SoupRepairer(soup, options).run();
+}
+
+} // namespace remora

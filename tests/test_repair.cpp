@@ -1,0 +1,311 @@
+// The soup repair: every step on small hand-made soups, and its accounting invariants.
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+#include <sstream>
+
+#include <OpenMesh/Tools/Utils/MeshCheckerT.hh>
+#include <gtest/gtest.h>
+
+#include "remora/common/error.h"
+#include "remora/mesh/repair.h"
+
+namespace remora {
+namespace {
+
+PolygonSoup soup_of(std::vector<Vec3> points,
+                    const std::vector<std::vector<std::uint32_t>>& polys) {
+  PolygonSoup s;
+  s.points = std::move(points);
+  for (const auto& p : polys) s.add_polygon(p.data(), p.size());
+  return s;
+}
+
+// The invariants every repair must keep, whatever the input.
+void expect_accounting(const RepairResult& r) {
+  const RepairReport& rep = r.report;
+  EXPECT_EQ(rep.triangles_in(), rep.faces_loaded + rep.faces_dropped());
+  EXPECT_EQ(rep.vertices_in + rep.vertices_added_by_split,
+            rep.unreferenced_vertices + rep.welded_vertices + rep.orphaned_vertices +
+                rep.vertices_loaded);
+  EXPECT_EQ(r.mesh.n_faces(), rep.faces_loaded);
+  EXPECT_EQ(r.mesh.n_vertices(), rep.vertices_loaded);
+  EXPECT_EQ(r.source_vertex.size(), r.mesh.n_vertices());
+  std::ostringstream problems;
+  EXPECT_TRUE(OpenMesh::Utils::MeshCheckerT<Mesh>(r.mesh).check(
+      OpenMesh::Utils::MeshCheckerT<Mesh>::CHECK_ALL, problems))
+      << problems.str();
+  for (auto v : r.mesh.vertices()) {
+    EXPECT_TRUE(r.mesh.is_manifold(v)) << "vertex " << v.idx();
+    EXPECT_FALSE(r.mesh.is_isolated(v)) << "vertex " << v.idx();
+  }
+}
+
+double signed_volume(const Mesh& m) {
+  double v = 0;
+  for (auto f : m.faces()) {
+    auto h = m.halfedge_handle(f);
+    const Vec3& a = m.point(m.from_vertex_handle(h));
+    const Vec3& b = m.point(m.to_vertex_handle(h));
+    const Vec3& c = m.point(m.to_vertex_handle(m.next_halfedge_handle(h)));
+    v += OpenMesh::dot(a, OpenMesh::cross(b, c)) / 6.0;
+  }
+  return v;
+}
+
+bool is_closed(const Mesh& m) {
+  for (auto h : m.halfedges())
+    if (m.is_boundary(h)) return false;
+  return true;
+}
+
+// A unit cube as 12 triangles, every triangle with its own three vertices (like STL).
+PolygonSoup stl_cube(const std::vector<int>& flipped = {}) {
+  const Vec3 c[8] = {{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {0, 1, 0},
+                     {0, 0, 1}, {1, 0, 1}, {1, 1, 1}, {0, 1, 1}};
+  const int tris[12][3] = {{0, 2, 1}, {0, 3, 2}, {4, 5, 6}, {4, 6, 7}, {0, 1, 5}, {0, 5, 4},
+                           {1, 2, 6}, {1, 6, 5}, {2, 3, 7}, {2, 7, 6}, {3, 0, 4}, {3, 4, 7}};
+  PolygonSoup s;
+  for (int t = 0; t < 12; ++t) {
+    const bool flip = std::find(flipped.begin(), flipped.end(), t) != flipped.end();
+    const std::uint32_t base = static_cast<std::uint32_t>(s.points.size());
+    for (int k = 0; k < 3; ++k) s.points.push_back(c[tris[t][k]]);
+    if (flip)
+      s.add_triangle(base, base + 2, base + 1);
+    else
+      s.add_triangle(base, base + 1, base + 2);
+  }
+  return s;
+}
+
+TEST(Repair, WeldsAnStlCubeIntoOneClosedOutwardComponent) {
+  const RepairResult r = repair_soup(stl_cube());
+  expect_accounting(r);
+  EXPECT_EQ(r.report.welded_vertices, 36u - 8u);
+  EXPECT_EQ(r.mesh.n_vertices(), 8u);
+  EXPECT_EQ(r.mesh.n_faces(), 12u);
+  EXPECT_TRUE(is_closed(r.mesh));
+  EXPECT_NEAR(signed_volume(r.mesh), 1.0, 1e-12);
+  EXPECT_EQ(r.report.flipped_faces, 0u);
+}
+
+TEST(Repair, OrientsRandomlyWoundFacetsOutward) {
+  const std::vector<int> flipped = {1, 4, 7, 8, 11};
+  const RepairResult r = repair_soup(stl_cube(flipped));
+  expect_accounting(r);
+  EXPECT_EQ(r.report.flipped_faces, flipped.size());
+  EXPECT_TRUE(is_closed(r.mesh));
+  EXPECT_NEAR(signed_volume(r.mesh), 1.0, 1e-12);
+}
+
+TEST(Repair, TurnsAnInsideOutClosedSurfaceOutward) {
+  std::vector<int> all(12);
+  for (int i = 0; i < 12; ++i) all[i] = i;
+  const RepairResult r = repair_soup(stl_cube(all));
+  EXPECT_EQ(r.report.flipped_faces, 12u);
+  EXPECT_NEAR(signed_volume(r.mesh), 1.0, 1e-12);
+  RepairOptions keep;
+  keep.outward = false;
+  const RepairResult kept = repair_soup(stl_cube(all), keep);
+  EXPECT_EQ(kept.report.flipped_faces, 0u);
+  EXPECT_NEAR(signed_volume(kept.mesh), -1.0, 1e-12);
+}
+
+TEST(Repair, OpenSurfaceKeepsTheMajorityWinding) {
+  // A 4x4 grid of quads split into triangles, 3 of 32 triangles wound the other way.
+  PolygonSoup s;
+  for (int j = 0; j <= 4; ++j)
+    for (int i = 0; i <= 4; ++i) s.points.push_back(Vec3(i, j, 0));
+  int t = 0;
+  for (int j = 0; j < 4; ++j)
+    for (int i = 0; i < 4; ++i) {
+      const std::uint32_t a = static_cast<std::uint32_t>(j * 5 + i), b = a + 1, c = a + 6,
+                          d = a + 5;
+      for (const auto& tri : {std::array<std::uint32_t, 3>{a, b, c}, {a, c, d}}) {
+        if (t == 3 || t == 17 || t == 30)
+          s.add_triangle(tri[0], tri[2], tri[1]);
+        else
+          s.add_triangle(tri[0], tri[1], tri[2]);
+        ++t;
+      }
+    }
+  const RepairResult r = repair_soup(s);
+  expect_accounting(r);
+  EXPECT_EQ(r.report.flipped_faces, 3u);
+  for (auto f : r.mesh.faces()) EXPECT_GT(r.mesh.calc_face_normal(f)[2], 0.0);
+}
+
+TEST(Repair, CountsAndDropsUnreferencedVertices) {
+  auto s = soup_of({{0, 0, 0}, {9, 9, 9}, {1, 0, 0}, {0, 1, 0}, {7, 7, 7}}, {{0, 2, 3}});
+  const RepairResult r = repair_soup(s);
+  expect_accounting(r);
+  EXPECT_EQ(r.report.unreferenced_vertices, 2u);
+  EXPECT_EQ(r.mesh.n_vertices(), 3u);
+  EXPECT_EQ(r.source_vertex, (std::vector<std::uint32_t>{0, 2, 3}));
+}
+
+TEST(Repair, DropsRepeatedVertexAndDuplicateTriangles) {
+  auto s = soup_of({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {1, 1, 0}, {1, 0, 0}},
+                   {{0, 1, 2},
+                    {1, 3, 2},
+                    {0, 0, 1},   // repeated index
+                    {0, 4, 1},   // repeated after welding (4 == 1)
+                    {2, 0, 1},   // same triangle, rotated
+                    {0, 2, 1},   // same triangle, reversed
+                    {3, 2, 4}}); // the second triangle again, through the welded copy
+  const RepairResult r = repair_soup(s);
+  expect_accounting(r);
+  EXPECT_EQ(r.report.dropped_repeated_vertex, 2u);
+  EXPECT_EQ(r.report.dropped_duplicate, 3u);
+  EXPECT_EQ(r.mesh.n_faces(), 2u);
+}
+
+TEST(Repair, DropsPolygonsWithFewerThanThreeCorners) {
+  auto s = soup_of({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {{0, 1}, {0, 1, 2}});
+  const RepairResult r = repair_soup(s);
+  expect_accounting(r);
+  EXPECT_EQ(r.report.dropped_degenerate_polygon, 1u);
+  EXPECT_EQ(r.mesh.n_faces(), 1u);
+}
+
+double total_area(const Mesh& m) {
+  double a = 0;
+  for (auto f : m.faces()) {
+    auto h = m.halfedge_handle(f);
+    const Vec3& p = m.point(m.from_vertex_handle(h));
+    const Vec3& q = m.point(m.to_vertex_handle(h));
+    const Vec3& r = m.point(m.to_vertex_handle(m.next_halfedge_handle(h)));
+    a += 0.5 * OpenMesh::cross(q - p, r - p).norm();
+  }
+  return a;
+}
+
+TEST(Repair, TriangulatesANonConvexPolygonWithoutOverlap) {
+  // An L-shaped hexagon (area 3) in a tilted plane, and a quad.
+  const double c = std::cos(0.3), s = std::sin(0.3);
+  auto tilt = [&](double x, double y) { return Vec3(x, c * y, s * y); };
+  auto soup = soup_of({tilt(0, 0), tilt(2, 0), tilt(2, 1), tilt(1, 1), tilt(1, 2), tilt(0, 2)},
+                      {{0, 1, 2, 3, 4, 5}});
+  const RepairResult r = repair_soup(soup);
+  expect_accounting(r);
+  EXPECT_EQ(r.report.polygons_triangulated, 1u);
+  EXPECT_EQ(r.report.triangles_added_by_triangulation, 3u);
+  EXPECT_EQ(r.mesh.n_faces(), 4u);
+  // No overlap and no gap: the triangles' areas add up to the polygon's, all wound like it.
+  EXPECT_NEAR(total_area(r.mesh), 3.0, 1e-12);
+  const Vec3 normal(0, -s, c);
+  for (auto f : r.mesh.faces()) EXPECT_GT(OpenMesh::dot(r.mesh.calc_face_normal(f), normal), 0.99);
+}
+
+TEST(Repair, SplitsANonManifoldEdgeShownByThreePages) {
+  // Three triangles hinged on the edge (0,1): a "book" with three pages.
+  auto s = soup_of({{0, 0, 0}, {0, 0, 1}, {1, 0, 0}, {-0.5, 0.8, 0}, {-0.5, -0.8, 0}},
+                   {{0, 1, 2}, {1, 0, 3}, {1, 0, 4}});
+  const RepairResult r = repair_soup(s);
+  expect_accounting(r);
+  EXPECT_EQ(r.report.nonmanifold_edges, 1u);
+  EXPECT_EQ(r.mesh.n_faces(), 3u);
+  EXPECT_EQ(r.report.faces_detached, 0u);
+  EXPECT_GT(r.report.vertices_added_by_split, 0u);
+}
+
+TEST(Repair, SplitsABowTieVertex) {
+  auto s =
+      soup_of({{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {-1, 0, 0}, {-1, -1, 0}}, {{0, 1, 2}, {0, 3, 4}});
+  const RepairResult r = repair_soup(s);
+  expect_accounting(r);
+  EXPECT_EQ(r.report.split_vertices, 1u);
+  EXPECT_EQ(r.report.vertices_added_by_split, 1u);
+  EXPECT_EQ(r.mesh.n_vertices(), 6u);
+  EXPECT_EQ(r.source_vertex[5], 0u);
+}
+
+TEST(Repair, TwoClosedCubesSharingAnEdgeStayClosed) {
+  PolygonSoup a = stl_cube();
+  PolygonSoup b = stl_cube({0, 3, 6});
+  // Second cube shifted by (1,1,0): it touches the first along the edge x=1, y=1.
+  const std::uint32_t base = static_cast<std::uint32_t>(a.points.size());
+  for (Vec3 p : b.points) a.points.push_back(p + Vec3(1, 1, 0));
+  for (std::size_t f = 0; f < b.num_polygons(); ++f)
+    a.add_triangle(base + b.indices[3 * f], base + b.indices[3 * f + 1],
+                   base + b.indices[3 * f + 2]);
+  const RepairResult r = repair_soup(a);
+  expect_accounting(r);
+  EXPECT_EQ(r.report.nonmanifold_edges, 1u);
+  EXPECT_EQ(r.mesh.n_faces(), 24u);
+  EXPECT_EQ(r.report.faces_detached, 0u);
+  EXPECT_TRUE(is_closed(r.mesh));
+  EXPECT_NEAR(signed_volume(r.mesh), 2.0, 1e-12);
+}
+
+TEST(Repair, CutsAMoebiusStripWhereItsOrientationConflicts) {
+  // A Moebius band of 12 quads (24 triangles).
+  const int n = 12;
+  PolygonSoup s;
+  for (int i = 0; i < n; ++i) {
+    const double t = 2 * M_PI * i / n, half = t / 2;
+    for (double w : {-0.3, 0.3})
+      s.points.push_back(Vec3((1 + w * std::cos(half)) * std::cos(t),
+                              (1 + w * std::cos(half)) * std::sin(t), w * std::sin(half)));
+  }
+  for (int i = 0; i < n; ++i) {
+    const std::uint32_t a = static_cast<std::uint32_t>(2 * i), b = a + 1;
+    std::uint32_t c = static_cast<std::uint32_t>(2 * ((i + 1) % n)), d = c + 1;
+    if (i == n - 1) std::swap(c, d); // the half twist
+    s.add_triangle(a, c, b);
+    s.add_triangle(b, c, d);
+  }
+  const RepairResult r = repair_soup(s);
+  expect_accounting(r);
+  EXPECT_EQ(r.mesh.n_faces(), 24u);
+  EXPECT_EQ(r.report.orientation_cuts, 1u);
+  EXPECT_EQ(r.report.faces_detached, 0u);
+}
+
+TEST(Repair, RandomSoupsNeverBreakTheInvariants) {
+  std::mt19937 rng(12345);
+  for (int trial = 0; trial < 1000; ++trial) {
+    std::uniform_int_distribution<int> nv_dist(3, 12);
+    const int nv = nv_dist(rng);
+    PolygonSoup s;
+    std::uniform_real_distribution<double> coord(-1, 1);
+    for (int i = 0; i < nv; ++i) s.points.push_back(Vec3(coord(rng), coord(rng), coord(rng)));
+    std::uniform_int_distribution<std::uint32_t> id(0, static_cast<std::uint32_t>(nv - 1));
+    std::uniform_int_distribution<int> size(2, 5);
+    const int nf = std::uniform_int_distribution<int>(1, 30)(rng);
+    for (int f = 0; f < nf; ++f) {
+      std::vector<std::uint32_t> p(static_cast<std::size_t>(size(rng)));
+      for (auto& i : p) i = id(rng);
+      s.add_polygon(p.data(), p.size());
+    }
+    const RepairResult r = repair_soup(s);
+    SCOPED_TRACE("trial " + std::to_string(trial));
+    expect_accounting(r);
+  }
+}
+
+TEST(Repair, RejectsOutOfRangeIndices) {
+  auto s = soup_of({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {{0, 1, 3}});
+  EXPECT_THROW(repair_soup(s), InvalidArgument);
+}
+
+TEST(Repair, CountsZeroAreaFacesAndKeepsThem) {
+  // A sliver whose apex lies on its base edge, next to a proper triangle.
+  auto s = soup_of({{0, 0, 0}, {2, 0, 0}, {1, 0, 0}, {1, 1, 0}}, {{0, 2, 1}, {0, 1, 3}});
+  const RepairResult r = repair_soup(s);
+  expect_accounting(r);
+  EXPECT_EQ(r.report.zero_area_faces, 1u);
+  EXPECT_EQ(r.mesh.n_faces(), 2u);
+}
+
+TEST(Repair, DescribeListsOnlyWhatChanged) {
+  EXPECT_TRUE(describe(repair_soup(stl_cube()).report).size() == 1u); // the weld
+  const auto lines = describe(repair_soup(stl_cube({2})).report);
+  ASSERT_EQ(lines.size(), 2u);
+  EXPECT_EQ(lines[0], "28 coincident vertices welded");
+  EXPECT_EQ(lines[1], "1 faces flipped to orient their component consistently");
+}
+
+} // namespace
+} // namespace remora
