@@ -161,6 +161,42 @@ TEST(Repair, DropsRepeatedVertexAndDuplicateTriangles) {
   EXPECT_EQ(r.mesh.n_faces(), 2u);
 }
 
+TEST(Repair, ARepeatedFaceThatClosesASurfaceKeepsOneCopy) {
+  PolygonSoup s = stl_cube();
+  s.add_triangle(s.indices[0], s.indices[1], s.indices[2]);
+  const RepairResult r = repair_soup(s);
+  expect_accounting(r);
+  EXPECT_EQ(r.report.dropped_duplicate, 1u);
+  EXPECT_EQ(r.report.dropped_flap, 0u);
+  EXPECT_TRUE(is_closed(r.mesh));
+}
+
+TEST(Repair, ADoubledFlapHingedOnOneEdgeIsRemovedEntirely) {
+  // A cube with a zero-thickness flap (one triangle listed twice, opposite windings) hinged on
+  // its edge (0,0,0)-(1,0,0), as in cad/conrod.stl.
+  PolygonSoup s = stl_cube();
+  const std::uint32_t a = static_cast<std::uint32_t>(s.points.size());
+  s.points.push_back({0, 0, 0});
+  s.points.push_back({1, 0, 0});
+  s.points.push_back({0.5, -1, -1});
+  s.add_triangle(a, a + 1, a + 2);
+  s.add_triangle(a, a + 2, a + 1);
+  const RepairResult r = repair_soup(s);
+  expect_accounting(r);
+  EXPECT_EQ(r.report.dropped_flap, 2u);
+  EXPECT_EQ(r.report.orphaned_vertices, 1u);
+  EXPECT_EQ(r.report.nonmanifold_edges, 0u);
+  EXPECT_TRUE(is_closed(r.mesh));
+  EXPECT_EQ(r.mesh.n_faces(), 12u);
+}
+
+TEST(Repair, CountsTheFilesComponentsBeforeSplittingPinchVertices) {
+  // Two triangles sharing only a vertex: one component in the file, two once split.
+  auto s =
+      soup_of({{0, 0, 0}, {1, 0, 0}, {1, 1, 0}, {-1, 0, 0}, {-1, -1, 0}}, {{0, 1, 2}, {0, 3, 4}});
+  EXPECT_EQ(repair_soup(s).report.components_in, 1u);
+}
+
 TEST(Repair, DropsPolygonsWithFewerThanThreeCorners) {
   auto s = soup_of({{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {{0, 1}, {0, 1, 2}});
   const RepairResult r = repair_soup(s);

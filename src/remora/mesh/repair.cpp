@@ -152,6 +152,7 @@ public:
     weld();
     triangulate();
     drop_degenerate_and_duplicates();
+    count_components();
     build_edge_sides();
     if (options_.orient) orient();
     split_nonmanifold();
@@ -221,24 +222,80 @@ private:
   }
 
   // Step 4.
+  // Step 4. A triangle listed more than once keeps one copy, unless it is a zero-thickness flap:
+  // copies glued to the surface along a single edge (cad/conrod.stl has three), of which one copy
+  // kept would still be a fin on a non-manifold edge.
   void drop_degenerate_and_duplicates() {
-    std::unordered_set<Tri, TriHash> seen;
-    seen.reserve(tris_.size());
+    std::unordered_map<Tri, std::uint32_t, TriHash> copies; // sorted triple -> count
+    copies.reserve(tris_.size());
     std::size_t out = 0;
     for (const Tri& t : tris_) {
       if (t[0] == t[1] || t[1] == t[2] || t[2] == t[0]) {
         ++report_.dropped_repeated_vertex;
         continue;
       }
-      Tri sorted = t;
-      std::sort(sorted.begin(), sorted.end());
-      if (!seen.insert(sorted).second) {
-        ++report_.dropped_duplicate;
-        continue;
+      tris_[out++] = t;
+      ++copies[sorted(t)];
+    }
+    tris_.resize(out);
+    // Edge use by the distinct triangles.
+    std::unordered_map<std::uint64_t, std::uint32_t> edge_use;
+    edge_use.reserve(copies.size() * 2);
+    for (const auto& [t, n] : copies)
+      for (int k = 0; k < 3; ++k) ++edge_use[edge_key(t[k], t[(k + 1) % 3])];
+    // A flap hangs by one edge that two other triangles already share (one copy kept would
+    // make it non-manifold) and has no other neighbour.
+    auto is_flap = [&](const Tri& t) {
+      int hinges = 0, free_edges = 0;
+      for (int k = 0; k < 3; ++k) {
+        const std::uint32_t others = edge_use[edge_key(t[k], t[(k + 1) % 3])] - 1;
+        hinges += others >= 2 ? 1 : 0;
+        free_edges += others == 0 ? 1 : 0;
+      }
+      return hinges == 1 && free_edges == 2;
+    };
+    std::unordered_map<Tri, char, TriHash> keep_one; // for listed-more-than-once triples
+    for (const auto& [t, n] : copies)
+      if (n > 1) keep_one[t] = is_flap(t) ? 0 : 1;
+    out = 0;
+    for (const Tri& t : tris_) {
+      auto it = keep_one.find(sorted(t));
+      if (it != keep_one.end()) {
+        if (it->second == 1) {
+          it->second = 2; // the first copy is kept
+        } else if (it->second == 2) {
+          ++report_.dropped_duplicate;
+          continue;
+        } else {
+          ++report_.dropped_flap;
+          continue;
+        }
       }
       tris_[out++] = t;
     }
     tris_.resize(out);
+  }
+
+  static Tri sorted(Tri t) {
+    std::sort(t.begin(), t.end());
+    return t;
+  }
+
+  // The welded triangles' connected components through shared vertices (before any split).
+  void count_components() {
+    DisjointSets sets(points_.size());
+    for (const Tri& t : tris_) {
+      sets.unite(t[0], t[1]);
+      sets.unite(t[1], t[2]);
+    }
+    std::vector<char> root(points_.size(), 0);
+    for (const Tri& t : tris_) {
+      const std::uint32_t r = sets.find(t[0]);
+      if (!root[r]) {
+        root[r] = 1;
+        ++report_.components_in;
+      }
+    }
   }
 
   void build_edge_sides() {

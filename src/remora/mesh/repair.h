@@ -5,7 +5,8 @@
 //  2. weld coincident vertices (bit-identical coordinates, -0 == +0; STL shares no vertices);
 //  3. triangulate polygons with more than three corners (ear clipping in the best-fit plane);
 //  4. drop triangles with a repeated vertex (after welding; PLY strip "swap" triangles), and
-//     duplicate triangles (the same three vertices in any order; the first is kept);
+//     duplicate triangles (the same three vertices in any order; the first is kept, or none when
+//     the copies form a zero-thickness flap hinged on one edge);
 //  5. orient the triangles consistently per connected component (closed components outward, open
 //     ones keeping the majority of the file's winding); a non-orientable component is cut where the
 //     orientation conflicts;
@@ -50,11 +51,14 @@ struct RepairReport {
   std::size_t dropped_degenerate_polygon = 0;       ///< polygons with fewer than three corners
   std::size_t dropped_repeated_vertex = 0; ///< triangles using one vertex twice (after welding)
   std::size_t dropped_duplicate = 0;       ///< the same vertex triple as an earlier triangle
-  std::size_t flipped_faces = 0;           ///< triangles whose winding was reversed
+  std::size_t dropped_flap = 0; ///< both copies of a triangle listed twice as a zero-thickness flap
+  std::size_t flipped_faces = 0;     ///< triangles whose winding was reversed
   std::size_t orientation_cuts = 0;  ///< edges cut because orientations conflict (non-orientable)
   std::size_t nonmanifold_edges = 0; ///< edges with more than two triangles, split
   std::size_t faces_detached = 0;    ///< triangles given vertex copies of their own (not expected)
-  std::size_t zero_area_faces = 0;   ///< area <= 1e-12 * (bounding-box diagonal)^2, kept
+  std::size_t components_in =
+      0; ///< components of the welded triangles (sharing vertices), before splits
+  std::size_t zero_area_faces = 0; ///< area <= 1e-12 * (bounding-box diagonal)^2, kept
   // What came out.
   std::size_t vertices_loaded = 0;
   std::size_t faces_loaded = 0;
@@ -62,7 +66,7 @@ struct RepairReport {
   std::size_t triangles_in() const { return polygons_in + triangles_added_by_triangulation; }
   // vertices_in = unreferenced + welded + orphaned + vertices_loaded - vertices_added_by_split.
   std::size_t faces_dropped() const {
-    return dropped_repeated_vertex + dropped_duplicate + dropped_degenerate_polygon;
+    return dropped_repeated_vertex + dropped_duplicate + dropped_flap + dropped_degenerate_polygon;
   }
 };
 

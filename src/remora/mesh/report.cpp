@@ -1,20 +1,13 @@
 // The repair report's text and JSON forms.
 #include <nlohmann/json.hpp>
 
+#include "remora/common/text.h"
 #include "remora/mesh/repair.h"
 
 namespace remora {
 
 namespace {
-
-// 12888 -> "12,888"
-std::string grouped(std::size_t n) {
-  std::string s = std::to_string(n);
-  for (int i = static_cast<int>(s.size()) - 3; i > 0; i -= 3)
-    s.insert(static_cast<std::size_t>(i), ",");
-  return s;
-}
-
+const auto grouped = group_thousands;
 } // namespace
 
 std::vector<std::string> describe(const RepairReport& r) {
@@ -31,6 +24,7 @@ std::vector<std::string> describe(const RepairReport& r) {
   add(r.dropped_degenerate_polygon, "faces with fewer than 3 corners dropped");
   add(r.dropped_repeated_vertex, "faces with a repeated vertex dropped");
   add(r.dropped_duplicate, "duplicate faces dropped");
+  add(r.dropped_flap, "faces dropped that doubled up into zero-thickness flaps");
   add(r.orphaned_vertices, "vertices dropped with their faces");
   add(r.flipped_faces, "faces flipped to orient their component consistently");
   add(r.orientation_cuts, "edges cut where the orientation conflicts (non-orientable)");
@@ -57,6 +51,8 @@ nlohmann::json to_json(const RepairReport& r) {
           {"dropped_degenerate_polygon", r.dropped_degenerate_polygon},
           {"dropped_repeated_vertex", r.dropped_repeated_vertex},
           {"dropped_duplicate", r.dropped_duplicate},
+          {"dropped_flap", r.dropped_flap},
+          {"components_in", r.components_in},
           {"faces_dropped", r.faces_dropped()},
           {"flipped_faces", r.flipped_faces},
           {"orientation_cuts", r.orientation_cuts},
