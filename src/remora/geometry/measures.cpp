@@ -1,0 +1,143 @@
+#include "remora/geometry/measures.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+namespace remora {
+namespace {
+
+std::array<Vec3, 3> face_points(const Mesh& mesh, FaceHandle f) {
+  const HalfedgeHandle h0 = mesh.halfedge_handle(f);
+  const HalfedgeHandle h1 = mesh.next_halfedge_handle(h0);
+  const HalfedgeHandle h2 = mesh.next_halfedge_handle(h1);
+  return {mesh.point(mesh.to_vertex_handle(h0)), mesh.point(mesh.to_vertex_handle(h1)),
+          mesh.point(mesh.to_vertex_handle(h2))};
+}
+
+std::array<VertexHandle, 3> face_vertices(const Mesh& mesh, FaceHandle f) {
+  const HalfedgeHandle h0 = mesh.halfedge_handle(f);
+  const HalfedgeHandle h1 = mesh.next_halfedge_handle(h0);
+  const HalfedgeHandle h2 = mesh.next_halfedge_handle(h1);
+  return {mesh.to_vertex_handle(h0), mesh.to_vertex_handle(h1), mesh.to_vertex_handle(h2)};
+}
+
+double max_abs_component(const Vec3& v) {
+  return std::max({std::abs(v[0]), std::abs(v[1]), std::abs(v[2])});
+}
+
+double corner_angle(const Vec3& u, const Vec3& v) {
+  return std::atan2((u % v).norm(), u | v);
+}
+
+} // namespace
+
+double triangle_area(const Vec3& a, const Vec3& b, const Vec3& c) {
+  return 0.5 * ((b - a) % (c - a)).norm();
+}
+
+double face_area(const Mesh& mesh, FaceHandle f) {
+  const std::array<Vec3, 3> p = face_points(mesh, f);
+  return triangle_area(p[0], p[1], p[2]);
+}
+
+double surface_area(const Mesh& mesh) {
+  double sum = 0.0;
+  for (const FaceHandle f : mesh.faces()) sum += face_area(mesh, f);
+  return sum;
+}
+
+std::array<double, 3> triangle_angles(const Vec3& a, const Vec3& b, const Vec3& c) {
+  constexpr double pi = std::numbers::pi;
+  Vec3 ab = b - a;
+  Vec3 ac = c - a;
+  Vec3 bc = c - b;
+  const double largest =
+      std::max({max_abs_component(ab), max_abs_component(ac), max_abs_component(bc)});
+  if (largest == 0.0) return {0.0, 0.0, pi};
+  // Scaling by a power of two is exact and brings the largest component into [0.5, 1), so squared
+  // lengths, cross and dot products neither underflow nor overflow: the result is scale-invariant.
+  int exponent = 0;
+  std::frexp(largest, &exponent);
+  const double scale = std::ldexp(1.0, -exponent);
+  ab *= scale;
+  ac *= scale;
+  bc *= scale;
+  // An edge whose squared length underflows is zero-length relative to the triangle. At most one
+  // can be: the largest component bounds some edge's squared length from below by 1/4.
+  if (ab.sqrnorm() == 0.0) return {pi / 2, pi / 2, 0.0};
+  if (bc.sqrnorm() == 0.0) return {0.0, pi / 2, pi / 2};
+  if (ac.sqrnorm() == 0.0) return {pi / 2, 0.0, pi / 2};
+  return {corner_angle(ab, ac), corner_angle(-ab, bc), corner_angle(ac, bc)};
+}
+
+std::array<double, 3> triangle_mixed_areas(const Vec3& a, const Vec3& b, const Vec3& c) {
+  const Vec3 e0 = c - b; // opposite a
+  const Vec3 e1 = a - c; // opposite b
+  const Vec3 e2 = b - a; // opposite c
+  const double twice_area = (e2 % (c - a)).norm();
+  if (!(twice_area > 0.0)) return {0.0, 0.0, 0.0};
+  const double area = 0.5 * twice_area;
+  // Corner dot products: cot of the corner's angle is d / twice_area, and d < 0 means obtuse.
+  const double d0 = -(e1 | e2);
+  const double d1 = -(e2 | e0);
+  const double d2 = -(e0 | e1);
+  if (d0 < 0.0) return {area / 2, area / 4, area / 4};
+  if (d1 < 0.0) return {area / 4, area / 2, area / 4};
+  if (d2 < 0.0) return {area / 4, area / 4, area / 2};
+  const double l0 = e0.sqrnorm();
+  const double l1 = e1.sqrnorm();
+  const double l2 = e2.sqrnorm();
+  const double denominator = 8.0 * twice_area;
+  const auto part = [area, denominator](double value) {
+    return std::clamp(value / denominator, 0.0, area);
+  };
+  return {part(l1 * d1 + l2 * d2), part(l2 * d2 + l0 * d0), part(l1 * d1 + l0 * d0)};
+}
+
+Eigen::VectorXd vertex_areas_barycentric(const Mesh& mesh) {
+  Eigen::VectorXd areas = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(mesh.n_vertices()));
+  for (const FaceHandle f : mesh.faces()) {
+    const double third = face_area(mesh, f) / 3.0;
+    for (const VertexHandle v : face_vertices(mesh, f)) areas[v.idx()] += third;
+  }
+  return areas;
+}
+
+Eigen::VectorXd vertex_areas_mixed(const Mesh& mesh) {
+  Eigen::VectorXd areas = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(mesh.n_vertices()));
+  for (const FaceHandle f : mesh.faces()) {
+    const std::array<VertexHandle, 3> v = face_vertices(mesh, f);
+    const std::array<double, 3> parts =
+        triangle_mixed_areas(mesh.point(v[0]), mesh.point(v[1]), mesh.point(v[2]));
+    for (int i = 0; i < 3; ++i) areas[v[i].idx()] += parts[i];
+  }
+  return areas;
+}
+
+BoundingBox bounding_box(const Mesh& mesh) {
+  BoundingBox box;
+  bool first = true;
+  for (const VertexHandle v : mesh.vertices()) {
+    const Vec3& p = mesh.point(v);
+    if (first) {
+      box.min = p;
+      box.max = p;
+      first = false;
+    } else {
+      box.min.minimize(p);
+      box.max.maximize(p);
+    }
+  }
+  return box;
+}
+
+double bounding_box_diagonal(const Mesh& mesh) {
+  return bounding_box(mesh).diagonal();
+}
+
+bool is_zero_area(double area, double bbox_diagonal) {
+  return area <= kZeroAreaRelative * bbox_diagonal * bbox_diagonal;
+}
+
+} // namespace remora
