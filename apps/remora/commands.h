@@ -1,0 +1,12 @@
+// The subcommands of the `remora` tool. Each registers itself on the app with a callback that
+// does the work; callbacks throw remora::Error on failure (main() reports it).
+#pragma once
+
+#include <CLI/CLI.hpp>
+
+namespace remora::cli {
+
+void add_info_command(CLI::App& app);
+void add_convert_command(CLI::App& app);
+
+} // namespace remora::cli

@@ -1,0 +1,141 @@
+// Wavefront OBJ: `v` and `f` lines; every other keyword is counted and read past.
+#include <limits>
+
+#include "remora/common/error.h"
+#include "remora/mesh/io_detail.h"
+
+namespace remora::io_detail {
+
+namespace {
+
+std::string_view trim_right(std::string_view s) {
+  while (!s.empty() && is_blank(s.back())) s.remove_suffix(1);
+  return s;
+}
+
+struct ForwardReference {
+  std::int64_t vertex; // 0-based
+  std::uint64_t line;
+};
+
+} // namespace
+
+SoupFile read_obj(std::string_view bytes, const std::string& name) {
+  check_text(bytes, name);
+  if (bytes.starts_with("\xEF\xBB\xBF")) bytes.remove_prefix(3); // UTF-8 byte-order mark
+
+  SoupFile result;
+  result.info.format = "obj";
+  result.info.encoding = "ascii";
+  PolygonSoup& soup = result.soup;
+  SkipCounter skipped;
+  // Indices beyond the vertices read so far are legal if the vertex comes later; checked at the end.
+  std::vector<ForwardReference> forward;
+  std::vector<std::uint32_t> corners;
+  std::string joined;
+
+  LineReader lines(bytes);
+  std::string_view raw;
+  while (lines.next(raw)) {
+    const std::uint64_t line_no = lines.line();
+    std::string_view line = trim_right(raw);
+    if (!line.empty() && line.back() == '\\') {
+      // A trailing backslash continues the statement on the next line.
+      joined.assign(line.substr(0, line.size() - 1));
+      std::string_view more;
+      while (lines.next(more)) {
+        more = trim_right(more);
+        joined += ' ';
+        if (more.empty() || more.back() != '\\') {
+          joined += more;
+          break;
+        }
+        joined += more.substr(0, more.size() - 1);
+      }
+      line = joined;
+    }
+    line = strip_comment(line);
+    if (line.empty()) continue;
+
+    std::string_view rest = line;
+    const std::string_view key = next_token(rest);
+    if (key == "v") {
+      // `v x y z [w] [r g b]`: anything after z is read past.
+      soup.points.push_back(parse_point(rest, soup.points.size() + 1, name, line_no));
+    } else if (key == "f") {
+      corners.clear();
+      const auto seen = static_cast<std::int64_t>(soup.points.size());
+      for (std::string_view token = next_token(rest); !token.empty(); token = next_token(rest)) {
+        // `i`, `i/t`, `i//n`, `i/t/n`: only the vertex index matters.
+        const std::string_view vertex_token = token.substr(0, token.find('/'));
+        const std::int64_t index = to_int(vertex_token, name, line_no, "vertex index of a face");
+        std::int64_t vertex = 0;
+        if (index > 0) {
+          vertex = index - 1;
+        } else if (index < 0) {
+          vertex = seen + index;
+          if (vertex < 0)
+            throw IoError(name,
+                          "relative vertex index " + std::to_string(index) +
+                              " points before the first vertex (only " + std::to_string(seen) +
+                              " vertices precede this face)",
+                          line_no);
+        } else {
+          throw IoError(name, "vertex index 0 in a face (OBJ indices start at 1)", line_no);
+        }
+        if (vertex >= static_cast<std::int64_t>(std::numeric_limits<std::uint32_t>::max()))
+          throw IoError(name, "vertex index " + std::to_string(index) + " is too large", line_no);
+        if (vertex >= seen) forward.push_back({vertex, line_no});
+        corners.push_back(static_cast<std::uint32_t>(vertex));
+      }
+      if (corners.size() < 3)
+        throw IoError(name,
+                      "face has " + std::to_string(corners.size()) + " corner" +
+                          plural(corners.size()) + "; a face needs at least 3",
+                      line_no);
+      soup.add_polygon(corners.data(), corners.size());
+    } else {
+      skipped.add(key);
+    }
+  }
+
+  const auto count = static_cast<std::int64_t>(soup.points.size());
+  for (const ForwardReference& ref : forward) {
+    if (ref.vertex >= count)
+      throw IoError(name,
+                    "face refers to vertex " + std::to_string(ref.vertex + 1) +
+                        " but the file has " + std::to_string(count) + " vertices",
+                    ref.line);
+  }
+  if (soup.num_polygons() == 0)
+    throw IoError(name, "no faces: the file has " + std::to_string(count) +
+                            " vertices and no 'f' lines (an empty mesh cannot be loaded)");
+
+  result.info.vertices_in_file = soup.points.size();
+  result.info.faces_in_file = soup.num_polygons();
+  skipped.report(result.info.skipped);
+  return result;
+}
+
+void write_obj(const CompactMesh& m, std::string& out) {
+  out.reserve(out.size() + 64 * m.points.size() + 24 * m.triangles.size());
+  for (const Vec3& p : m.points) {
+    out += "v ";
+    append_double(out, p[0]);
+    out += ' ';
+    append_double(out, p[1]);
+    out += ' ';
+    append_double(out, p[2]);
+    out += '\n';
+  }
+  for (std::size_t i = 0; i < m.triangles.size(); i += 3) {
+    out += 'f';
+    for (std::size_t k = 0; k < 3; ++k) {
+      out += ' ';
+      append_uint(out, std::uint64_t{m.triangles[i + k]} + 1);
+    }
+    out += '\n';
+  }
+}
+
+} // namespace remora::io_detail

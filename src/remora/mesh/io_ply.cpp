@@ -1,0 +1,717 @@
+// PLY 1.0: ascii, binary_little_endian, binary_big_endian; faces from `element face` or
+// `element tristrips`; every other element is read past and reported.
+#include <charconv>
+#include <limits>
+
+#include "remora/common/error.h"
+#include "remora/mesh/io_detail.h"
+
+namespace remora::io_detail {
+
+namespace {
+
+enum class PlyType : std::uint8_t { Int8, Uint8, Int16, Uint16, Int32, Uint32, Float32, Float64 };
+
+struct TypeName {
+  std::string_view name;
+  PlyType type;
+};
+constexpr TypeName kTypeNames[] = {
+    {"char", PlyType::Int8},      {"int8", PlyType::Int8},       {"uchar", PlyType::Uint8},
+    {"uint8", PlyType::Uint8},    {"short", PlyType::Int16},     {"int16", PlyType::Int16},
+    {"ushort", PlyType::Uint16},  {"uint16", PlyType::Uint16},   {"int", PlyType::Int32},
+    {"int32", PlyType::Int32},    {"uint", PlyType::Uint32},     {"uint32", PlyType::Uint32},
+    {"float", PlyType::Float32},  {"float32", PlyType::Float32}, {"double", PlyType::Float64},
+    {"float64", PlyType::Float64}};
+
+std::size_t type_size(PlyType t) {
+  switch (t) {
+  case PlyType::Int8:
+  case PlyType::Uint8:
+    return 1;
+  case PlyType::Int16:
+  case PlyType::Uint16:
+    return 2;
+  case PlyType::Int32:
+  case PlyType::Uint32:
+  case PlyType::Float32:
+    return 4;
+  case PlyType::Float64:
+    return 8;
+  }
+  return 0;
+}
+
+bool is_integer(PlyType t) {
+  return t != PlyType::Float32 && t != PlyType::Float64;
+}
+
+double load_double(const char* p, PlyType t, bool big) {
+  switch (t) {
+  case PlyType::Int8:
+    return load<std::int8_t>(p, big);
+  case PlyType::Uint8:
+    return load<std::uint8_t>(p, big);
+  case PlyType::Int16:
+    return load<std::int16_t>(p, big);
+  case PlyType::Uint16:
+    return load<std::uint16_t>(p, big);
+  case PlyType::Int32:
+    return load<std::int32_t>(p, big);
+  case PlyType::Uint32:
+    return load<std::uint32_t>(p, big);
+  case PlyType::Float32:
+    return load<float>(p, big);
+  case PlyType::Float64:
+    return load<double>(p, big);
+  }
+  return 0;
+}
+
+// Integer types only (the header check rejects float counts and indices).
+std::int64_t load_int(const char* p, PlyType t, bool big) {
+  switch (t) {
+  case PlyType::Int8:
+    return load<std::int8_t>(p, big);
+  case PlyType::Uint8:
+    return load<std::uint8_t>(p, big);
+  case PlyType::Int16:
+    return load<std::int16_t>(p, big);
+  case PlyType::Uint16:
+    return load<std::uint16_t>(p, big);
+  case PlyType::Int32:
+    return load<std::int32_t>(p, big);
+  case PlyType::Uint32:
+    return load<std::uint32_t>(p, big);
+  case PlyType::Float32:
+  case PlyType::Float64:
+    break;
+  }
+  return 0;
+}
+
+// What a property is read for; everything else is read past.
+enum class Role : std::uint8_t { Skip, X, Y, Z, Indices };
+
+struct PlyProperty {
+  std::string name;
+  PlyType type = PlyType::Float32; ///< the value type (of the entries, for a list)
+  bool list = false;
+  PlyType count_type = PlyType::Uint8;
+  Role role = Role::Skip;
+};
+
+enum class Kind : std::uint8_t { Skip, Vertex, Face, Strips };
+
+struct PlyElement {
+  std::string name;
+  std::uint64_t count = 0;
+  std::vector<PlyProperty> properties;
+  std::uint64_t line = 0; ///< header line of `element`
+  Kind kind = Kind::Skip;
+  std::size_t min_size = 0; ///< bytes of a binary record with every list empty
+  bool fixed = true;        ///< no lists: every binary record has min_size bytes
+};
+
+struct PlyHeader {
+  std::string encoding;
+  bool ascii = true;
+  bool big_endian = false;
+  std::vector<PlyElement> elements;
+  std::size_t data_offset = 0; ///< first byte after the end_header line
+  std::uint64_t lines = 0;     ///< lines up to and including end_header
+};
+
+std::string count_phrase(const PlyElement& e, std::uint64_t n) {
+  if (e.name == "vertex") return count_of(n, "vertex", "vertices");
+  if (e.name == "face") return count_of(n, "face", "faces");
+  return std::to_string(n) + " '" + e.name + "' record" + plural(n);
+}
+
+std::string record_label(const PlyElement& e, std::uint64_t r) {
+  if (e.name == "vertex" || e.name == "face") return e.name + " " + std::to_string(r);
+  return "'" + e.name + "' record " + std::to_string(r);
+}
+
+std::uint64_t sat_add(std::uint64_t a, std::uint64_t b) {
+  return b > std::numeric_limits<std::uint64_t>::max() - a
+             ? std::numeric_limits<std::uint64_t>::max()
+             : a + b;
+}
+
+std::uint64_t sat_mul(std::uint64_t a, std::uint64_t b) {
+  if (a != 0 && b > std::numeric_limits<std::uint64_t>::max() / a)
+    return std::numeric_limits<std::uint64_t>::max();
+  return a * b;
+}
+
+PlyType parse_type(std::string_view token, const std::string& name, std::uint64_t line) {
+  for (const TypeName& t : kTypeNames)
+    if (t.name == token) return t.type;
+  throw IoError(name,
+                "unknown property type '" + std::string(token) +
+                    "' (known: char uchar short ushort int uint float double, int8 uint8 int16 "
+                    "uint16 int32 uint32 float32 float64)",
+                line);
+}
+
+PlyHeader parse_header(std::string_view bytes, const std::string& name) {
+  if (bytes.empty()) throw IoError(name, "no faces: the file is empty");
+  PlyHeader h;
+  LineReader lines(bytes);
+  std::string_view raw;
+  bool have_format = false;
+  bool ended = false;
+  while (!ended) {
+    const std::size_t start = lines.offset();
+    if (!lines.next(raw)) {
+      throw IoError(name, "the header has no 'end_header' line", lines.line());
+    }
+    const std::uint64_t line = lines.line();
+    check_text(raw, name, line, start);
+    std::string_view rest = raw;
+    const std::string_view key = next_token(rest);
+    if (line == 1) {
+      if (key != "ply" || !next_token(rest).empty())
+        throw IoError(name, "not a PLY file: the first line is not 'ply'", line);
+      continue;
+    }
+    if (key.empty() || key == "comment" || key == "obj_info") continue;
+    if (key == "end_header") {
+      ended = true;
+    } else if (key == "format") {
+      const std::string_view encoding = next_token(rest);
+      const std::string_view version = next_token(rest);
+      if (encoding == "ascii") {
+        h.ascii = true;
+      } else if (encoding == "binary_little_endian") {
+        h.ascii = false;
+        h.big_endian = false;
+      } else if (encoding == "binary_big_endian") {
+        h.ascii = false;
+        h.big_endian = true;
+      } else {
+        throw IoError(name,
+                      "unknown PLY format '" + std::string(encoding) +
+                          "' (known: ascii, binary_little_endian, binary_big_endian)",
+                      line);
+      }
+      if (version != "1.0" || !next_token(rest).empty())
+        throw IoError(
+            name, "unsupported format line: expected 'format " + std::string(encoding) + " 1.0'",
+            line);
+      if (have_format) throw IoError(name, "a second 'format' line", line);
+      have_format = true;
+      h.encoding = encoding;
+    } else if (key == "element") {
+      PlyElement e;
+      e.name = next_token(rest);
+      const std::string_view count = next_token(rest);
+      if (e.name.empty() || count.empty() || !next_token(rest).empty())
+        throw IoError(name, "bad element line: expected 'element NAME COUNT'", line);
+      const std::int64_t n = to_int(count, name, line, "element count");
+      if (n < 0) throw IoError(name, "negative element count " + std::to_string(n), line);
+      e.count = static_cast<std::uint64_t>(n);
+      e.line = line;
+      h.elements.push_back(std::move(e));
+    } else if (key == "property") {
+      if (h.elements.empty()) throw IoError(name, "'property' before any 'element' line", line);
+      PlyProperty p;
+      const std::string_view type = next_token(rest);
+      if (type == "list") {
+        p.list = true;
+        const std::string_view count_type = next_token(rest);
+        const std::string_view item_type = next_token(rest);
+        if (count_type.empty() || item_type.empty())
+          throw IoError(name, "bad property line: expected 'property list COUNT_TYPE TYPE NAME'",
+                        line);
+        p.count_type = parse_type(count_type, name, line);
+        p.type = parse_type(item_type, name, line);
+        if (!is_integer(p.count_type))
+          throw IoError(name,
+                        "list length type '" + std::string(count_type) + "' is not an integer type",
+                        line);
+      } else {
+        if (type.empty()) throw IoError(name, "bad property line: no type", line);
+        p.type = parse_type(type, name, line);
+      }
+      p.name = next_token(rest);
+      if (p.name.empty() || !next_token(rest).empty())
+        throw IoError(name, "bad property line: expected 'property TYPE NAME'", line);
+      h.elements.back().properties.push_back(std::move(p));
+    } else {
+      throw IoError(name, "unknown header line starting with '" + std::string(key) + "'", line);
+    }
+  }
+  if (!have_format) throw IoError(name, "the header has no 'format' line", lines.line());
+  h.data_offset = lines.offset();
+  h.lines = lines.line();
+  return h;
+}
+
+// Gives every element and property its role, and checks that the faces can be read.
+void assign_roles(PlyHeader& h, const std::string& name) {
+  const PlyElement* vertex = nullptr;
+  bool any_faces = false;
+  for (PlyElement& e : h.elements) {
+    for (const PlyProperty& p : e.properties) {
+      e.min_size += type_size(p.list ? p.count_type : p.type);
+      if (p.list) e.fixed = false;
+    }
+    if (e.name == "vertex") {
+      if (vertex != nullptr) throw IoError(name, "a second 'vertex' element", e.line);
+      e.kind = Kind::Vertex;
+      vertex = &e;
+      if (e.count >= std::numeric_limits<std::uint32_t>::max())
+        throw IoError(name, "too many vertices: " + std::to_string(e.count), e.line);
+      const char* axes[3] = {"x", "y", "z"};
+      for (int k = 0; k < 3; ++k) {
+        PlyProperty* found = nullptr;
+        for (PlyProperty& p : e.properties)
+          if (p.name == axes[k] && found == nullptr) found = &p;
+        if (found == nullptr)
+          throw IoError(name, std::string("element vertex has no property '") + axes[k] + "'",
+                        e.line);
+        if (found->list)
+          throw IoError(name, std::string("property '") + axes[k] + "' of element vertex is a list",
+                        e.line);
+        found->role = static_cast<Role>(static_cast<int>(Role::X) + k);
+      }
+    } else if (e.name == "face" || e.name == "tristrips") {
+      for (const PlyElement& other : h.elements) {
+        if (&other == &e) break;
+        if (other.name == e.name) throw IoError(name, "a second '" + e.name + "' element", e.line);
+      }
+      if (vertex == nullptr)
+        throw IoError(name,
+                      "element " + e.name +
+                          " comes before element vertex (faces must follow the vertices they use)",
+                      e.line);
+      e.kind = e.name == "face" ? Kind::Face : Kind::Strips;
+      PlyProperty* found = nullptr;
+      for (PlyProperty& p : e.properties) {
+        const bool match =
+            p.name == "vertex_indices" || (e.kind == Kind::Face && p.name == "vertex_index");
+        if (match && found == nullptr) found = &p;
+      }
+      if (found == nullptr)
+        throw IoError(name,
+                      "element " + e.name + " has no list property 'vertex_indices'" +
+                          (e.kind == Kind::Face ? " or 'vertex_index'" : ""),
+                      e.line);
+      if (!found->list || !is_integer(found->type))
+        throw IoError(name,
+                      "property '" + found->name + "' of element " + e.name +
+                          " must be a list of integers",
+                      e.line);
+      found->role = Role::Indices;
+      any_faces = true;
+    }
+  }
+  if (!any_faces)
+    throw IoError(name, "no faces: the header declares no 'face' or 'tristrips' element (an empty "
+                        "mesh cannot be loaded)");
+}
+
+// Ascii records: one per line; a line with too few or too many values is an error.
+class AsciiSource {
+public:
+  AsciiSource(std::string_view body, std::uint64_t lines_before, const std::string& name,
+              const std::vector<PlyElement>& elements)
+      : lines_(body, lines_before), name_(name), elements_(elements) {}
+
+  void begin_record(std::size_t element, std::uint64_t record) {
+    element_ = element;
+    record_ = record;
+    std::string_view raw;
+    while (lines_.next(raw)) {
+      rest_ = raw;
+      for (const char c : raw)
+        if (!is_blank(c)) return;
+    }
+    const PlyElement& e = elements_[element];
+    throw IoError(name_,
+                  "header declares " + count_phrase(e, e.count) + " but the file ends after " +
+                      std::to_string(record),
+                  lines_.line());
+  }
+
+  double read_double(const PlyProperty& p) {
+    const std::string_view token = take(p);
+    double v = 0;
+    if (!parse_double(token, v)) to_double(token, name_, lines_.line(), what(p));
+    return v;
+  }
+
+  std::int64_t read_int(const PlyProperty& p) {
+    const std::string_view token = take(p);
+    std::int64_t v = 0;
+    if (!parse_int(token, v)) to_int(token, name_, lines_.line(), what(p));
+    return v;
+  }
+
+  std::uint64_t read_count(const PlyProperty& p) {
+    const std::int64_t n = read_int(p);
+    if (n < 0) fail("negative list length " + std::to_string(n) + " (" + what(p) + ")");
+    return static_cast<std::uint64_t>(n);
+  }
+
+  void skip(const PlyProperty& p) { take(p); }
+
+  void skip_items(const PlyProperty& p, std::uint64_t n) {
+    for (std::uint64_t i = 0; i < n; ++i) take(p);
+  }
+
+  void end_record() {
+    if (!next_token(rest_).empty()) {
+      const PlyElement& e = elements_[element_];
+      fail(record_label(e, record_) + " has more values than its " +
+           std::to_string(e.properties.size()) + " properties in the header");
+    }
+  }
+
+  void skip_element(std::size_t element) {
+    const PlyElement& e = elements_[element];
+    for (std::uint64_t r = 0; r < e.count; ++r) {
+      begin_record(element, r);
+      for (const PlyProperty& p : e.properties) {
+        if (p.list)
+          skip_items(p, read_count(p));
+        else
+          skip(p);
+      }
+      end_record();
+    }
+  }
+
+  void finish(const PlyElement& last) {
+    std::string_view raw;
+    while (lines_.next(raw)) {
+      for (const char c : raw)
+        if (!is_blank(c))
+          fail("data continues after the " + count_phrase(last, last.count) +
+               " the header declares");
+    }
+  }
+
+  [[noreturn]] void fail(const std::string& problem) const {
+    throw IoError(name_, problem, lines_.line());
+  }
+  [[noreturn]] void fail_record(const std::string& problem) const { fail(problem); }
+
+private:
+  std::string_view take(const PlyProperty& p) {
+    const std::string_view token = next_token(rest_);
+    if (token.empty()) {
+      const PlyElement& e = elements_[element_];
+      if (lines_.only_blank_left())
+        fail("the file ends in the middle of " + record_label(e, record_) + " (property '" +
+             p.name + "' is missing)");
+      fail(record_label(e, record_) + " has too few values: property '" + p.name + "' is missing");
+    }
+    return token;
+  }
+
+  std::string what(const PlyProperty& p) const {
+    return "property '" + p.name + "' of " + record_label(elements_[element_], record_);
+  }
+
+  LineReader lines_;
+  const std::string& name_;
+  const std::vector<PlyElement>& elements_;
+  std::string_view rest_;
+  std::size_t element_ = 0;
+  std::uint64_t record_ = 0;
+};
+
+// Binary records, bounds-checked at every read.
+class BinarySource {
+public:
+  BinarySource(std::string_view bytes, std::size_t start, bool big_endian, const std::string& name,
+               const std::vector<PlyElement>& elements)
+      : data_(bytes.data()), size_(bytes.size()), pos_(start), big_(big_endian), name_(name),
+        elements_(elements) {}
+
+  void begin_record(std::size_t element, std::uint64_t record) {
+    element_ = element;
+    record_ = record;
+    record_start_ = pos_;
+  }
+
+  double read_double(const PlyProperty& p) {
+    return load_double(take(type_size(p.type)), p.type, big_);
+  }
+
+  std::int64_t read_int(const PlyProperty& p) {
+    return load_int(take(type_size(p.type)), p.type, big_);
+  }
+
+  std::uint64_t read_count(const PlyProperty& p) {
+    const std::int64_t n = load_int(take(type_size(p.count_type)), p.count_type, big_);
+    if (n < 0)
+      fail("negative list length " + std::to_string(n) + " (property '" + p.name + "' of " +
+           record_label(elements_[element_], record_) + ")");
+    return static_cast<std::uint64_t>(n);
+  }
+
+  void skip(const PlyProperty& p) { take(type_size(p.type)); }
+
+  void skip_items(const PlyProperty& p, std::uint64_t n) { take(sat_mul(n, type_size(p.type))); }
+
+  void end_record() {}
+
+  void skip_element(std::size_t element) {
+    const PlyElement& e = elements_[element];
+    if (e.fixed) {
+      // Fixed-size records are skipped in one step.
+      const std::uint64_t total = sat_mul(e.count, e.min_size);
+      if (total > size_ - pos_) {
+        begin_record(element, (size_ - pos_) / e.min_size);
+        pos_ = record_start_ = pos_ + record_ * e.min_size;
+        truncated(e.min_size);
+      }
+      pos_ += static_cast<std::size_t>(total);
+      return;
+    }
+    for (std::uint64_t r = 0; r < e.count; ++r) {
+      begin_record(element, r);
+      for (const PlyProperty& p : e.properties) {
+        if (p.list)
+          skip_items(p, read_count(p));
+        else
+          skip(p);
+      }
+    }
+  }
+
+  void finish(const PlyElement& last) {
+    if (pos_ < size_)
+      throw IoError(name_,
+                    "data continues after the " + count_phrase(last, last.count) +
+                        " the header declares (" +
+                        count_of(size_ - pos_, "extra byte", "extra bytes") + ")",
+                    {}, pos_);
+  }
+
+  /// At the value last read.
+  [[noreturn]] void fail(const std::string& problem) const {
+    throw IoError(name_, problem, {}, value_start_);
+  }
+  /// At the start of the current record.
+  [[noreturn]] void fail_record(const std::string& problem) const {
+    throw IoError(name_, problem, {}, record_start_);
+  }
+
+private:
+  const char* take(std::uint64_t n) {
+    if (n > size_ - pos_) truncated(n);
+    value_start_ = pos_;
+    const char* p = data_ + pos_;
+    pos_ += static_cast<std::size_t>(n);
+    return p;
+  }
+
+  // The file ends inside the current record. `n`: bytes the failing read wanted.
+  [[noreturn]] void truncated(std::uint64_t n) const {
+    const PlyElement& e = elements_[element_];
+    // The least the header's counts need: this record with its lists as read so far, the rest
+    // of this element and the later ones with every list empty.
+    std::uint64_t need = std::max<std::uint64_t>(sat_add(pos_, n), record_start_ + e.min_size);
+    need = sat_add(need, sat_mul(e.count - record_ - 1, e.min_size));
+    bool exact = e.fixed;
+    for (std::size_t i = element_ + 1; i < elements_.size(); ++i) {
+      need = sat_add(need, sat_mul(elements_[i].count, elements_[i].min_size));
+      exact = exact && elements_[i].fixed;
+    }
+    throw IoError(name_,
+                  "file ends at byte " + std::to_string(size_) + " but the header's counts need " +
+                      (exact ? "" : "at least ") + std::to_string(need) + " bytes (" +
+                      record_label(e, record_) + " of " + std::to_string(e.count) + " is cut off)",
+                  {}, record_start_);
+  }
+
+  const char* data_;
+  std::size_t size_;
+  std::size_t pos_;
+  bool big_;
+  const std::string& name_;
+  const std::vector<PlyElement>& elements_;
+  std::size_t element_ = 0;
+  std::uint64_t record_ = 0;
+  std::size_t record_start_ = 0;
+  std::size_t value_start_ = 0;
+};
+
+// Strip s yields triangles (s[i], s[i+1], s[i+2]), every other one with the first two swapped so
+// that all keep the strip's winding. Degenerate "swap" triangles are kept: the repair counts them.
+void add_strip(const std::vector<std::uint32_t>& s, PolygonSoup& soup, std::size_t& triangles) {
+  for (std::size_t i = 0; i + 2 < s.size(); ++i) {
+    if (i % 2 == 0)
+      soup.add_triangle(s[i], s[i + 1], s[i + 2]);
+    else
+      soup.add_triangle(s[i + 1], s[i], s[i + 2]);
+    ++triangles;
+  }
+}
+
+template <class Source>
+void read_body(Source& src, const PlyHeader& h, std::size_t file_size, SoupFile& result) {
+  PolygonSoup& soup = result.soup;
+  std::uint64_t vertex_count = 0;
+  std::vector<std::uint32_t> corners;
+
+  for (std::size_t ei = 0; ei < h.elements.size(); ++ei) {
+    const PlyElement& e = h.elements[ei];
+    if (e.properties.empty()) {
+      // Records without properties occupy no bytes and no text.
+      if (e.kind == Kind::Skip)
+        result.info.skipped.push_back("element " + e.name + " (" + std::to_string(e.count) + ")");
+      continue;
+    }
+    switch (e.kind) {
+    case Kind::Skip:
+      src.skip_element(ei);
+      result.info.skipped.push_back("element " + e.name + " (" + std::to_string(e.count) + ")");
+      break;
+    case Kind::Vertex:
+      vertex_count = e.count;
+      soup.points.reserve(reserve_count(e.count, file_size, h.ascii ? 6 : e.min_size));
+      for (std::uint64_t r = 0; r < e.count; ++r) {
+        src.begin_record(ei, r);
+        Vec3 point(0, 0, 0);
+        for (const PlyProperty& p : e.properties) {
+          if (p.list)
+            src.skip_items(p, src.read_count(p));
+          else if (p.role == Role::Skip)
+            src.skip(p);
+          else
+            point[static_cast<int>(p.role) - static_cast<int>(Role::X)] = src.read_double(p);
+        }
+        src.end_record();
+        if (!is_finite(point))
+          src.fail_record(non_finite_problem(point, "vertex " + std::to_string(r)));
+        soup.points.push_back(point);
+      }
+      result.info.vertices_in_file = soup.points.size();
+      break;
+    case Kind::Face:
+    case Kind::Strips: {
+      const bool strips = e.kind == Kind::Strips;
+      if (!strips) {
+        const std::size_t n = reserve_count(e.count, file_size, h.ascii ? 6 : e.min_size);
+        soup.offsets.reserve(soup.offsets.size() + n);
+        soup.indices.reserve(soup.indices.size() + 3 * n);
+      }
+      std::size_t faces = 0;
+      for (std::uint64_t r = 0; r < e.count; ++r) {
+        src.begin_record(ei, r);
+        corners.clear();
+        for (const PlyProperty& p : e.properties) {
+          if (p.role != Role::Indices) {
+            if (p.list)
+              src.skip_items(p, src.read_count(p));
+            else
+              src.skip(p);
+            continue;
+          }
+          const std::uint64_t n = src.read_count(p);
+          if (!strips && n < 3)
+            src.fail("face " + std::to_string(r) + " has " + std::to_string(n) +
+                     " corners; a face needs at least 3");
+          for (std::uint64_t k = 0; k < n; ++k) {
+            const std::int64_t index = src.read_int(p);
+            if (index >= 0 && static_cast<std::uint64_t>(index) < vertex_count) {
+              corners.push_back(static_cast<std::uint32_t>(index));
+            } else if (strips && index == -1) {
+              add_strip(corners, soup, faces);
+              corners.clear();
+            } else if (index < 0) {
+              src.fail(record_label(e, r) + " has the negative vertex index " +
+                       std::to_string(index) + (strips ? " (only -1 may separate strips)" : ""));
+            } else {
+              src.fail(record_label(e, r) + " refers to vertex " + std::to_string(index) +
+                       " but the file has " + std::to_string(vertex_count) + " vertices");
+            }
+          }
+        }
+        src.end_record();
+        if (strips) {
+          add_strip(corners, soup, faces);
+        } else {
+          soup.add_polygon(corners.data(), corners.size());
+          ++faces;
+        }
+      }
+      result.info.faces_in_file += faces;
+      break;
+    }
+    }
+  }
+  src.finish(h.elements.back());
+}
+
+} // namespace
+
+SoupFile read_ply(std::string_view bytes, const std::string& name) {
+  PlyHeader h = parse_header(bytes, name);
+  assign_roles(h, name);
+
+  SoupFile result;
+  result.info.format = "ply";
+  result.info.encoding = h.encoding;
+  if (h.ascii) {
+    const std::string_view body = bytes.substr(h.data_offset);
+    check_text(body, name, h.lines + 1, h.data_offset);
+    AsciiSource src(body, h.lines, name, h.elements);
+    read_body(src, h, bytes.size(), result);
+  } else {
+    BinarySource src(bytes, h.data_offset, h.big_endian, name, h.elements);
+    read_body(src, h, bytes.size(), result);
+  }
+  if (result.soup.num_polygons() == 0)
+    throw IoError(name, "no faces: the file declares " +
+                            std::to_string(result.info.vertices_in_file) +
+                            " vertices and no faces (an empty mesh cannot be loaded)");
+  return result;
+}
+
+void write_ply(const CompactMesh& m, bool binary, std::string& out) {
+  const std::size_t faces = m.triangles.size() / 3;
+  out += "ply\nformat ";
+  out += binary ? "binary_little_endian" : "ascii";
+  out += " 1.0\ncomment written by Remora\nelement vertex ";
+  append_uint(out, m.points.size());
+  out += "\nproperty double x\nproperty double y\nproperty double z\nelement face ";
+  append_uint(out, faces);
+  out += "\nproperty list uchar int vertex_indices\nend_header\n";
+  if (binary) {
+    out.reserve(out.size() + 24 * m.points.size() + 13 * faces);
+    for (const Vec3& p : m.points)
+      for (int k = 0; k < 3; ++k) append_le(out, p[k]);
+    for (std::size_t f = 0; f < faces; ++f) {
+      append_le(out, std::uint8_t{3});
+      for (std::size_t k = 0; k < 3; ++k)
+        append_le(out, static_cast<std::int32_t>(m.triangles[3 * f + k]));
+    }
+    return;
+  }
+  out.reserve(out.size() + 64 * m.points.size() + 24 * faces);
+  for (const Vec3& p : m.points) {
+    append_double(out, p[0]);
+    out += ' ';
+    append_double(out, p[1]);
+    out += ' ';
+    append_double(out, p[2]);
+    out += '\n';
+  }
+  for (std::size_t f = 0; f < faces; ++f) {
+    out += '3';
+    for (std::size_t k = 0; k < 3; ++k) {
+      out += ' ';
+      append_uint(out, m.triangles[3 * f + k]);
+    }
+    out += '\n';
+  }
+}
+
+} // namespace remora::io_detail

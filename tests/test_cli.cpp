@@ -1,0 +1,146 @@
+// The `remora` command line tool, run as a user would: exit codes, one clear error line, JSON
+// that parses and agrees with the library, files written only on success.
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "remora/geometry/quality.h"
+#include "remora/mesh/io.h"
+#include "remora/mesh/primitives.h"
+
+namespace remora {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct CliRun {
+  int exit_code;
+  std::string out;
+  std::string err;
+};
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::ostringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+class Cli : public ::testing::Test {
+protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("remora_cli_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  CliRun run(const std::string& args) {
+    const fs::path out = dir_ / "stdout.txt", err = dir_ / "stderr.txt";
+    const std::string cmd = std::string(REMORA_CLI) + " " + args + " >" + out.string() + " 2>" +
+                            err.string() + " </dev/null";
+    const int status = std::system(cmd.c_str());
+    CliRun r{WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(out), slurp(err)};
+    fs::remove(out);
+    fs::remove(err);
+    return r;
+  }
+
+  fs::path write_text(const std::string& name, const std::string& text) {
+    const fs::path p = dir_ / name;
+    std::ofstream(p, std::ios::binary) << text;
+    return p;
+  }
+
+  fs::path dir_;
+};
+
+TEST_F(Cli, InfoJsonAgreesWithTheLibrary) {
+  const fs::path cube = dir_ / "cube.off";
+  write_mesh(cube.string(), make_cube(3, 2.0));
+  const CliRun r = run("info --json " + cube.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  const MeshQuality q = mesh_quality(read_mesh(cube.string()).mesh);
+  EXPECT_EQ(j, [&] {
+    nlohmann::json e = to_json(q);
+    e["load"] = to_json(read_mesh(cube.string()).report);
+    return e;
+  }());
+  EXPECT_EQ(j["load"]["repair"]["faces_loaded"], 108);
+}
+
+TEST_F(Cli, InfoTableNamesTheFiguresAndTheRepair) {
+  const CliRun r = run(std::string("info ") + REMORA_REPO_DATA + "/bunny.ply");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  for (const char* key : {"1,113 unreferenced vertices dropped", "69,451 faces", "5 boundary loops",
+                          "mixed Voronoi", "mean |theta-60|"})
+    EXPECT_NE(r.out.find(key), std::string::npos) << key << "\n" << r.out;
+}
+
+TEST_F(Cli, BrokenFileIsOneLineNamingTheFileAndPlaceWithExitCode1) {
+  const fs::path bad = write_text("bad.obj", "v 0 0 0\nv 1 0 0\nv 0 nan 0\nf 1 2 3\n");
+  const CliRun r = run("info " + bad.string());
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_TRUE(r.out.empty());
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_NE(r.err.find("bad.obj: line 3"), std::string::npos) << r.err;
+}
+
+TEST_F(Cli, MissingFileAndUnknownExtensionFailCleanly) {
+  EXPECT_EQ(run("info " + (dir_ / "nothing.ply").string()).exit_code, 1);
+  const fs::path txt = write_text("mesh.txt", "hello");
+  const CliRun r = run("info " + txt.string());
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("mesh.txt"), std::string::npos) << r.err;
+}
+
+TEST_F(Cli, UnknownFlagOrMissingArgumentIsAUsageError) {
+  EXPECT_EQ(run("info --no-such-flag x.obj").exit_code, 2);
+  EXPECT_EQ(run("convert x.obj").exit_code, 2); // no -o
+  EXPECT_EQ(run("").exit_code, 2);              // no subcommand
+}
+
+TEST_F(Cli, ConvertWritesEveryFormatAndReportsTheRepair) {
+  const fs::path in = dir_ / "in.stl";
+  write_mesh(in.string(), make_icosphere(2));
+  for (const char* ext : {"obj", "off", "ply", "stl"}) {
+    const fs::path out = dir_ / (std::string("out.") + ext);
+    const CliRun r = run("convert " + in.string() + " -o " + out.string());
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.out.find("coincident vertices welded"), std::string::npos) << r.out;
+    const LoadResult back = read_mesh(out.string());
+    EXPECT_EQ(back.mesh.n_faces(), 320u);
+    EXPECT_EQ(back.mesh.n_vertices(), 162u);
+  }
+}
+
+TEST_F(Cli, FailedConvertLeavesNoFile) {
+  const fs::path in = dir_ / "in.off";
+  write_mesh(in.string(), make_cube(1, 1.0));
+  const CliRun unknown = run("convert " + in.string() + " -o " + (dir_ / "out.xyz").string());
+  EXPECT_EQ(unknown.exit_code, 1);
+  const CliRun missing_dir =
+      run("convert " + in.string() + " -o " + (dir_ / "no" / "such" / "out.obj").string());
+  EXPECT_EQ(missing_dir.exit_code, 1);
+  const fs::path broken = write_text("broken.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n");
+  const CliRun truncated = run("convert " + broken.string() + " -o " + (dir_ / "out.obj").string());
+  EXPECT_EQ(truncated.exit_code, 1);
+  for (const auto& entry : fs::directory_iterator(dir_))
+    EXPECT_TRUE(entry.path().filename() == "in.off" || entry.path().filename() == "broken.off")
+        << "left behind: " << entry.path();
+}
+
+} // namespace
+} // namespace remora
