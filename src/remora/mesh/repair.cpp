@@ -226,8 +226,6 @@ private:
   // copies glued to the surface along a single edge (cad/conrod.stl has three), of which one copy
   // kept would still be a fin on a non-manifold edge.
   void drop_degenerate_and_duplicates() {
-    std::unordered_map<Tri, std::uint32_t, TriHash> copies; // sorted triple -> count
-    copies.reserve(tris_.size());
     std::size_t out = 0;
     for (const Tri& t : tris_) {
       if (t[0] == t[1] || t[1] == t[2] || t[2] == t[0]) {
@@ -235,14 +233,41 @@ private:
         continue;
       }
       tris_[out++] = t;
-      ++copies[sorted(t)];
     }
     tris_.resize(out);
-    // Edge use by the distinct triangles.
+    // Group equal vertex triples by sorting (faster than hashing at a million triangles).
+    struct Keyed {
+      Tri key;
+      std::uint32_t tri;
+    };
+    std::vector<Keyed> keyed(tris_.size());
+    for (std::uint32_t t = 0; t < tris_.size(); ++t) keyed[t] = {sorted(tris_[t]), t};
+    std::sort(keyed.begin(), keyed.end(), [](const Keyed& a, const Keyed& b) {
+      return a.key != b.key ? a.key < b.key : a.tri < b.tri;
+    });
+    std::vector<std::pair<std::size_t, std::size_t>> runs; // [begin, end) of repeated triples
+    for (std::size_t i = 0; i < keyed.size();) {
+      std::size_t j = i + 1;
+      while (j < keyed.size() && keyed[j].key == keyed[i].key) ++j;
+      if (j - i > 1) runs.emplace_back(i, j);
+      i = j;
+    }
+    if (runs.empty()) return;
+    // Edge use by the distinct triangles, for the edges of repeated triples only.
     std::unordered_map<std::uint64_t, std::uint32_t> edge_use;
-    edge_use.reserve(copies.size() * 2);
-    for (const auto& [t, n] : copies)
-      for (int k = 0; k < 3; ++k) ++edge_use[edge_key(t[k], t[(k + 1) % 3])];
+    for (const auto& [b, e] : runs)
+      for (int k = 0; k < 3; ++k) {
+        const Tri& t = keyed[b].key;
+        edge_use[edge_key(t[k], t[(k + 1) % 3])] = 0;
+      }
+    for (std::size_t i = 0; i < keyed.size(); ++i) {
+      if (i > 0 && keyed[i].key == keyed[i - 1].key) continue; // count each triple once
+      const Tri& t = keyed[i].key;
+      for (int k = 0; k < 3; ++k) {
+        auto it = edge_use.find(edge_key(t[k], t[(k + 1) % 3]));
+        if (it != edge_use.end()) ++it->second;
+      }
+    }
     // A flap hangs by one edge that two other triangles already share (one copy kept would
     // make it non-manifold) and has no other neighbour.
     auto is_flap = [&](const Tri& t) {
@@ -254,25 +279,15 @@ private:
       }
       return hinges == 1 && free_edges == 2;
     };
-    std::unordered_map<Tri, char, TriHash> keep_one; // for listed-more-than-once triples
-    for (const auto& [t, n] : copies)
-      if (n > 1) keep_one[t] = is_flap(t) ? 0 : 1;
-    out = 0;
-    for (const Tri& t : tris_) {
-      auto it = keep_one.find(sorted(t));
-      if (it != keep_one.end()) {
-        if (it->second == 1) {
-          it->second = 2; // the first copy is kept
-        } else if (it->second == 2) {
-          ++report_.dropped_duplicate;
-          continue;
-        } else {
-          ++report_.dropped_flap;
-          continue;
-        }
-      }
-      tris_[out++] = t;
+    std::vector<char> drop(tris_.size(), 0);
+    for (const auto& [b, e] : runs) {
+      const bool flap = is_flap(keyed[b].key);
+      for (std::size_t i = flap ? b : b + 1; i < e; ++i) drop[keyed[i].tri] = 1;
+      (flap ? report_.dropped_flap : report_.dropped_duplicate) += flap ? e - b : e - b - 1;
     }
+    out = 0;
+    for (std::uint32_t t = 0; t < tris_.size(); ++t)
+      if (!drop[t]) tris_[out++] = tris_[t];
     tris_.resize(out);
   }
 
@@ -391,8 +406,10 @@ private:
         }
       }
     }
-    // The sides' corners refer to the old winding; rebuild them.
-    build_edge_sides();
+    // Swapping a triangle's corners 1 and 2 moves its edge at corner k to corner 2 - k; the sort
+    // order (by edge, then triangle) is unchanged.
+    for (EdgeSide& side : sides_)
+      if (flip[side.tri]) side.corner = static_cast<std::uint8_t>(2 - side.corner);
   }
 
   // Step 6: decide which triangle pairs are joined across each edge, then give every fan of
@@ -516,20 +533,32 @@ private:
   // more into the fans of triangles that now actually share edges, so that each output vertex has
   // exactly one fan and the half-edge structure is well defined.
   void detach_conflicts_and_resplit() {
-    std::unordered_set<std::uint64_t> directed;
-    directed.reserve(tris_.size() * 3);
-    for (Tri& t : tris_) {
-      bool free = true;
-      for (int k = 0; k < 3; ++k)
-        free = free && !directed.count(std::uint64_t(t[k]) << 32 | t[(k + 1) % 3]);
-      if (free) {
-        for (int k = 0; k < 3; ++k) directed.insert(std::uint64_t(t[k]) << 32 | t[(k + 1) % 3]);
-        continue;
-      }
-      ++report_.faces_detached;
-      for (int k = 0; k < 3; ++k) t[k] = add_copy(t[k]);
-    }
+    // The common case: a manifold soup. No vertex was copied, so the sides are still current and
+    // every edge has at most two sides, of opposite directions.
+    if (out_points_.size() == points_.size() && report_.nonmanifold_edges == 0 &&
+        report_.orientation_cuts == 0)
+      return;
     build_edge_sides();
+    bool detached = false;
+    for (std::size_t g = 0; g + 1 < group_start_.size(); ++g) {
+      const std::uint32_t b = group_start_[g], e = group_start_[g + 1];
+      bool seen_forward = false, seen_backward = false;
+      for (std::uint32_t i = b; i < e; ++i) { // sides in triangle order: the first keeps its edge
+        Tri& t = tris_[sides_[i].tri];
+        if (t[sides_[i].corner] != static_cast<std::uint32_t>(sides_[i].key >> 32) &&
+            t[sides_[i].corner] != static_cast<std::uint32_t>(sides_[i].key & 0xffffffffu))
+          continue; // this triangle was detached already
+        bool& seen = forward(sides_[i]) ? seen_forward : seen_backward;
+        if (!seen) {
+          seen = true;
+          continue;
+        }
+        ++report_.faces_detached;
+        for (int k = 0; k < 3; ++k) t[k] = add_copy(t[k]);
+        detached = true;
+      }
+    }
+    if (detached) build_edge_sides();
     DisjointSets corners(tris_.size() * 3);
     for (std::size_t g = 0; g + 1 < group_start_.size(); ++g) {
       const std::uint32_t b = group_start_[g], e = group_start_[g + 1];
@@ -539,7 +568,10 @@ private:
       corners.unite(3 * s0.tri + s0.corner, 3 * s1.tri + (s1.corner + 1u) % 3);
       corners.unite(3 * s0.tri + (s0.corner + 1u) % 3, 3 * s1.tri + s1.corner);
     }
+    const std::size_t before = out_points_.size();
     assign_vertices(corners);
+    // New copies renumber edges: keep the sides current for build().
+    if (out_points_.size() != before) build_edge_sides();
   }
 
   // Builds the half-edge structure directly (every vertex has one fan, every directed edge one
@@ -547,6 +579,7 @@ private:
   RepairResult build() {
     RepairResult result;
     Mesh& mesh = result.mesh;
+    mesh.reserve(out_points_.size(), group_start_.size(), tris_.size());
     std::vector<VertexHandle> handle(out_points_.size());
     std::vector<std::uint32_t> copies(points_.size(), 0); // output vertices per welded vertex
     for (std::size_t v = 0; v < out_points_.size(); ++v) {
@@ -562,22 +595,26 @@ private:
         report_.vertices_added_by_split += c - 1;
       }
     }
-    std::unordered_map<std::uint64_t, HalfedgeHandle> edge; // (min,max) -> halfedge min -> max
-    edge.reserve(tris_.size() * 2);
-    for (const Tri& t : tris_) {
+    // One edge per group of sides (one or two, of opposite directions), in sorted order.
+    std::vector<HalfedgeHandle> side_halfedge(tris_.size() * 3); // by 3*t + corner
+    for (std::size_t g = 0; g + 1 < group_start_.size(); ++g) {
+      const std::uint32_t b = group_start_[g], e = group_start_[g + 1];
+      const EdgeSide& s0 = sides_[b];
+      const Tri& t0 = tris_[s0.tri];
+      const HalfedgeHandle h =
+          mesh.new_edge(handle[t0[s0.corner]], handle[t0[(s0.corner + 1) % 3]]);
+      side_halfedge[3 * s0.tri + s0.corner] = h;
+      for (std::uint32_t i = b + 1; i < e; ++i)
+        side_halfedge[3 * sides_[i].tri + sides_[i].corner] = mesh.opposite_halfedge_handle(h);
+    }
+    for (std::uint32_t t = 0; t < tris_.size(); ++t) {
       const FaceHandle fh = mesh.new_face();
-      HalfedgeHandle hs[3];
+      const HalfedgeHandle* hs = &side_halfedge[3 * t];
       for (int k = 0; k < 3; ++k) {
-        const std::uint32_t a = t[k], b = t[(k + 1) % 3];
-        auto [it, inserted] = edge.try_emplace(edge_key(a, b));
-        if (inserted)
-          it->second = a < b ? mesh.new_edge(handle[a], handle[b])
-                             : mesh.opposite_halfedge_handle(mesh.new_edge(handle[a], handle[b]));
-        hs[k] = a < b ? it->second : mesh.opposite_halfedge_handle(it->second);
         mesh.set_face_handle(hs[k], fh);
-        mesh.set_halfedge_handle(handle[a], hs[k]);
+        mesh.set_next_halfedge_handle(hs[k], hs[(k + 1) % 3]);
+        mesh.set_halfedge_handle(handle[tris_[t][k]], hs[k]);
       }
-      for (int k = 0; k < 3; ++k) mesh.set_next_halfedge_handle(hs[k], hs[(k + 1) % 3]);
       mesh.set_halfedge_handle(fh, hs[0]);
     }
     // Boundary halfedges: each vertex has at most one outgoing one, which follows the incoming
