@@ -48,7 +48,9 @@ const Expected kCatalogue[] = {
 };
 
 // Names the mesh in test listings instead of dumping the struct's bytes.
-void PrintTo(const Expected& e, std::ostream* os) { *os << e.path; }
+void PrintTo(const Expected& e, std::ostream* os) {
+  *os << e.path;
+}
 
 void expect_valid_halfedge_mesh(const Mesh& mesh) {
   std::ostringstream problems;

@@ -179,6 +179,26 @@ void append_uint(std::string& out, std::uint64_t v) {
   out.append(buf, res.ptr);
 }
 
+void append_point_line(std::string& out, const char* prefix, const Vec3& p) {
+  out += prefix;
+  append_double(out, p[0]);
+  out += ' ';
+  append_double(out, p[1]);
+  out += ' ';
+  append_double(out, p[2]);
+  out += '\n';
+}
+
+void append_triangle_line(std::string& out, const char* prefix, const std::uint32_t* ids,
+                          std::uint64_t base) {
+  out += prefix;
+  for (int k = 0; k < 3; ++k) {
+    out += ' ';
+    append_uint(out, std::uint64_t{ids[k]} + base);
+  }
+  out += '\n';
+}
+
 void SkipCounter::add(std::string_view keyword) {
   for (auto& [key, count] : counts_) {
     if (key == keyword) {

@@ -123,6 +123,11 @@ std::string non_finite_problem(const Vec3& p, const std::string& what);
 void append_double(std::string& out, double v);
 /// Appends `v` in decimal.
 void append_uint(std::string& out, std::uint64_t v);
+/// "x y z\n" with append_double, after `prefix` (e.g. "v ").
+void append_point_line(std::string& out, const char* prefix, const Vec3& p);
+/// "<prefix> a b c\n" with every index plus `base` (1 for OBJ, 0 otherwise).
+void append_triangle_line(std::string& out, const char* prefix, const std::uint32_t* ids,
+                          std::uint64_t base);
 
 /// Counts read-past lines per keyword, in the order first seen, for FileInfo::skipped.
 class SkipCounter {

@@ -119,23 +119,9 @@ SoupFile read_obj(std::string_view bytes, const std::string& name) {
 
 void write_obj(const CompactMesh& m, std::string& out) {
   out.reserve(out.size() + 64 * m.points.size() + 24 * m.triangles.size());
-  for (const Vec3& p : m.points) {
-    out += "v ";
-    append_double(out, p[0]);
-    out += ' ';
-    append_double(out, p[1]);
-    out += ' ';
-    append_double(out, p[2]);
-    out += '\n';
-  }
-  for (std::size_t i = 0; i < m.triangles.size(); i += 3) {
-    out += 'f';
-    for (std::size_t k = 0; k < 3; ++k) {
-      out += ' ';
-      append_uint(out, std::uint64_t{m.triangles[i + k]} + 1);
-    }
-    out += '\n';
-  }
+  for (const Vec3& p : m.points) append_point_line(out, "v ", p);
+  for (std::size_t i = 0; i < m.triangles.size(); i += 3)
+    append_triangle_line(out, "f", &m.triangles[i], 1);
 }
 
 } // namespace remora::io_detail

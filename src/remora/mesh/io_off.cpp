@@ -167,22 +167,9 @@ void write_off(const CompactMesh& m, std::string& out) {
   out += ' ';
   append_uint(out, m.triangles.size() / 3);
   out += " 0\n";
-  for (const Vec3& p : m.points) {
-    append_double(out, p[0]);
-    out += ' ';
-    append_double(out, p[1]);
-    out += ' ';
-    append_double(out, p[2]);
-    out += '\n';
-  }
-  for (std::size_t i = 0; i < m.triangles.size(); i += 3) {
-    out += '3';
-    for (std::size_t k = 0; k < 3; ++k) {
-      out += ' ';
-      append_uint(out, m.triangles[i + k]);
-    }
-    out += '\n';
-  }
+  for (const Vec3& p : m.points) append_point_line(out, "", p);
+  for (std::size_t i = 0; i < m.triangles.size(); i += 3)
+    append_triangle_line(out, "3", &m.triangles[i], 0);
 }
 
 } // namespace remora::io_detail

@@ -46,48 +46,36 @@ bool is_integer(PlyType t) {
   return t != PlyType::Float32 && t != PlyType::Float64;
 }
 
-double load_double(const char* p, PlyType t, bool big) {
+// A scalar of type t at p, converted to T. Integers are read only for integer types (the
+// header check rejects float counts and indices).
+template <class T>
+T load_as(const char* p, PlyType t, bool big) {
   switch (t) {
   case PlyType::Int8:
-    return load<std::int8_t>(p, big);
+    return static_cast<T>(load<std::int8_t>(p, big));
   case PlyType::Uint8:
-    return load<std::uint8_t>(p, big);
+    return static_cast<T>(load<std::uint8_t>(p, big));
   case PlyType::Int16:
-    return load<std::int16_t>(p, big);
+    return static_cast<T>(load<std::int16_t>(p, big));
   case PlyType::Uint16:
-    return load<std::uint16_t>(p, big);
+    return static_cast<T>(load<std::uint16_t>(p, big));
   case PlyType::Int32:
-    return load<std::int32_t>(p, big);
+    return static_cast<T>(load<std::int32_t>(p, big));
   case PlyType::Uint32:
-    return load<std::uint32_t>(p, big);
+    return static_cast<T>(load<std::uint32_t>(p, big));
   case PlyType::Float32:
-    return load<float>(p, big);
+    return static_cast<T>(load<float>(p, big));
   case PlyType::Float64:
-    return load<double>(p, big);
+    return static_cast<T>(load<double>(p, big));
   }
-  return 0;
+  return T{0};
 }
 
-// Integer types only (the header check rejects float counts and indices).
+double load_double(const char* p, PlyType t, bool big) {
+  return load_as<double>(p, t, big);
+}
 std::int64_t load_int(const char* p, PlyType t, bool big) {
-  switch (t) {
-  case PlyType::Int8:
-    return load<std::int8_t>(p, big);
-  case PlyType::Uint8:
-    return load<std::uint8_t>(p, big);
-  case PlyType::Int16:
-    return load<std::int16_t>(p, big);
-  case PlyType::Uint16:
-    return load<std::uint16_t>(p, big);
-  case PlyType::Int32:
-    return load<std::int32_t>(p, big);
-  case PlyType::Uint32:
-    return load<std::uint32_t>(p, big);
-  case PlyType::Float32:
-  case PlyType::Float64:
-    break;
-  }
-  return 0;
+  return load_as<std::int64_t>(p, t, big);
 }
 
 // What a property is read for; everything else is read past.
@@ -696,22 +684,9 @@ void write_ply(const CompactMesh& m, bool binary, std::string& out) {
     return;
   }
   out.reserve(out.size() + 64 * m.points.size() + 24 * faces);
-  for (const Vec3& p : m.points) {
-    append_double(out, p[0]);
-    out += ' ';
-    append_double(out, p[1]);
-    out += ' ';
-    append_double(out, p[2]);
-    out += '\n';
-  }
-  for (std::size_t f = 0; f < faces; ++f) {
-    out += '3';
-    for (std::size_t k = 0; k < 3; ++k) {
-      out += ' ';
-      append_uint(out, m.triangles[3 * f + k]);
-    }
-    out += '\n';
-  }
+  for (const Vec3& p : m.points) append_point_line(out, "", p);
+  for (std::size_t i = 0; i < m.triangles.size(); i += 3)
+    append_triangle_line(out, "3", &m.triangles[i], 0);
 }
 
 } // namespace remora::io_detail
