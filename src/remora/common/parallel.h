@@ -1,0 +1,17 @@
+// Data-parallel loops (OpenMP underneath). Each index must write only its own outputs; results
+// are then independent of the number of threads.
+#pragma once
+
+#include <cstddef>
+
+namespace remora {
+
+/// Runs body(i) for i in [0, n) on `threads` threads (0 = all hardware threads).
+template <class Body>
+void parallel_for(std::size_t n, int threads, Body&& body) {
+  const long count = static_cast<long>(n);
+#pragma omp parallel for schedule(static) num_threads(threads) if (threads != 1 && n > 1024)
+  for (long i = 0; i < count; ++i) body(static_cast<std::size_t>(i));
+}
+
+} // namespace remora

@@ -1,0 +1,117 @@
+#include "remora/geometry/laplacian.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "remora/geometry/measures.h"
+
+namespace remora {
+namespace {
+
+// Doubled area over the longest squared edge (about the smallest angle in radians) at or below
+// which a face counts as zero-area: its cotangents would be rounding noise of size up to 1e16.
+constexpr double kDegenerate = 1e-12;
+
+/// W_ij for every edge, indexed by edge idx() (0 for deleted edges).
+std::vector<double> edge_weights(const Mesh& mesh) {
+  std::vector<double> weights(mesh.n_edges(), 0.0);
+  for (const FaceHandle f : mesh.faces()) {
+    const HalfedgeHandle h0 = mesh.halfedge_handle(f);
+    const HalfedgeHandle h1 = mesh.next_halfedge_handle(h0);
+    const HalfedgeHandle h2 = mesh.next_halfedge_handle(h1);
+    // Corner k sits opposite halfedge opposite[k].
+    const std::array<HalfedgeHandle, 3> opposite{h1, h2, h0};
+    const std::array<Vec3, 3> p{mesh.point(mesh.from_vertex_handle(h0)),
+                                mesh.point(mesh.to_vertex_handle(h0)),
+                                mesh.point(mesh.to_vertex_handle(h1))};
+    // e[k] is the edge opposite corner k.
+    const std::array<Vec3, 3> e{p[2] - p[1], p[0] - p[2], p[1] - p[0]};
+    const std::array<double, 3> l{e[0].sqrnorm(), e[1].sqrnorm(), e[2].sqrnorm()};
+    // The doubled area from the two shortest edges (the most accurate pair).
+    const std::size_t longest =
+        l[0] >= l[1] && l[0] >= l[2] ? 0 : (l[1] >= l[2] ? std::size_t{1} : std::size_t{2});
+    const double twice_area = (e[(longest + 1) % 3] % e[(longest + 2) % 3]).norm();
+    if (!(twice_area > kDegenerate * l[longest])) continue;
+    for (std::size_t k = 0; k < 3; ++k) {
+      // The corner's edge vectors are -e[k+1] and e[k+2]; cot = their dot / |their cross|.
+      const double cot = -(e[(k + 1) % 3] | e[(k + 2) % 3]) / twice_area;
+      weights[mesh.edge_handle(opposite[k]).idx()] += 0.5 * cot;
+    }
+  }
+  return weights;
+}
+
+} // namespace
+
+Eigen::SparseMatrix<double> cotan_weights(const Mesh& mesh) {
+  const std::vector<double> weights = edge_weights(mesh);
+  const auto n = static_cast<Eigen::Index>(mesh.n_vertices());
+  Eigen::VectorXd diagonal = Eigen::VectorXd::Zero(n);
+  std::vector<bool> has_edge(mesh.n_vertices(), false);
+  std::vector<Eigen::Triplet<double>> triplets;
+  triplets.reserve(2 * mesh.n_edges() + mesh.n_vertices());
+  for (const EdgeHandle e : mesh.edges()) {
+    const HalfedgeHandle h = mesh.halfedge_handle(e, 0);
+    const int i = mesh.from_vertex_handle(h).idx();
+    const int j = mesh.to_vertex_handle(h).idx();
+    const double w = weights[e.idx()];
+    triplets.emplace_back(i, j, w);
+    triplets.emplace_back(j, i, w);
+    diagonal[i] -= w;
+    diagonal[j] -= w;
+    has_edge[i] = true;
+    has_edge[j] = true;
+  }
+  for (Eigen::Index i = 0; i < n; ++i) {
+    if (has_edge[i]) triplets.emplace_back(i, i, diagonal[i]);
+  }
+  Eigen::SparseMatrix<double> W(n, n);
+  W.setFromTriplets(triplets.begin(), triplets.end());
+  return W;
+}
+
+double laplacian_symmetry_defect(const Mesh& mesh) {
+  const std::vector<double> weights = edge_weights(mesh);
+  const Eigen::VectorXd areas = vertex_areas_mixed(mesh);
+  // Per row of W: the diagonal and the sum of the squared off-diagonal entries.
+  std::vector<double> diagonal(mesh.n_vertices(), 0.0);
+  std::vector<double> squares(mesh.n_vertices(), 0.0);
+  for (const EdgeHandle e : mesh.edges()) {
+    const HalfedgeHandle h = mesh.halfedge_handle(e, 0);
+    const int i = mesh.from_vertex_handle(h).idx();
+    const int j = mesh.to_vertex_handle(h).idx();
+    const double w = weights[e.idx()];
+    diagonal[i] -= w;
+    diagonal[j] -= w;
+    squares[i] += w * w;
+    squares[j] += w * w;
+  }
+  double area_sum = 0.0;
+  std::size_t counted = 0;
+  for (const VertexHandle v : mesh.vertices()) {
+    if (mesh.is_isolated(v)) continue;
+    area_sum += areas[v.idx()];
+    ++counted;
+  }
+  if (counted == 0 || !(area_sum > 0.0)) return 0.0;
+  const double mean = area_sum / static_cast<double>(counted);
+  // Row i of A^-1 W is row i of W over A_i; of A_bar^-1 W over A_bar. Their difference is row i of
+  // W times (A_bar - A_i) / (A_i A_bar), which is exactly 0 when the areas are equal.
+  double difference = 0.0;
+  double norm = 0.0;
+  for (const VertexHandle v : mesh.vertices()) {
+    const double a = areas[v.idx()];
+    if (mesh.is_isolated(v) || !(a > 0.0)) continue;
+    const double row = squares[v.idx()] + diagonal[v.idx()] * diagonal[v.idx()];
+    const double scale = (mean - a) / (a * mean);
+    difference += row * scale * scale;
+    norm += row / (a * a);
+  }
+  return norm > 0.0 ? std::sqrt(difference / norm) : 0.0;
+}
+
+} // namespace remora

@@ -1,0 +1,43 @@
+// Local closest-point search on a triangle mesh: from a face near the answer, walk over the mesh
+// to the closest point in O(1) work per query instead of a global search. The remesher uses it to
+// project vertices back onto the input surface and to carry the correspondence (paper §4).
+// Both walks are greedy descents of the distance to q; they find a local minimum, which is the
+// global one when q lies within a few edge lengths of the surface near `start` and the surface
+// does not fold back there. Deleted faces (status deleted, or halfedges without a face) are never
+// entered. Thread-safe for concurrent calls on the same const mesh; nothing is allocated.
+#pragma once
+
+#include "remora/mesh/mesh.h"
+#include "remora/mesh/surface_point.h"
+
+namespace remora {
+
+/// Steepest descent over faces. From f = start, each step evaluates the distance from q to every
+/// face sharing a vertex with f (the union of the one-rings of f's corners, exact distances by
+/// closest_point_on_triangle) and moves to the nearest one if it is closer than f by more than a
+/// relative 1e-12 of the squared distance; it stops when no face is, or after max_steps moves.
+/// Returns the closest point of the last face, as barycentrics w.r.t. face_vertices(face) (all
+/// >= 0, summing to 1).
+/// Throws InvalidArgument if start is not a face of mesh or is deleted, if q is not finite, or if
+/// max_steps < 0.
+SurfacePoint walk_to_closest(const Mesh& mesh, const Vec3& q, FaceHandle start,
+                             int max_steps = 64);
+
+/// A point on a boundary edge: `point` lies on the face across `halfedge` (a boundary halfedge,
+/// which has no face) with the barycentric weight of that face's third vertex exactly 0, and
+/// evaluates to (1 - t) from_vertex(halfedge) + t to_vertex(halfedge), t in [0, 1].
+struct BoundaryPoint {
+  SurfacePoint point;
+  HalfedgeHandle halfedge;
+  double t = 0.0;
+};
+
+/// The closest point to q on the boundary loop through `start`: from h = start, each step moves to
+/// the neighbouring boundary halfedge of the loop (next or prev) nearest to q if it is closer than
+/// h by more than a relative 1e-12 of the squared distance; it stops when neither is, or after
+/// max_steps moves. Throws InvalidArgument if start is not a halfedge of mesh, is deleted, is not
+/// a boundary halfedge or has no face on its other side, if q is not finite, or if max_steps < 0.
+BoundaryPoint walk_to_closest_on_boundary(const Mesh& mesh, const Vec3& q, HalfedgeHandle start,
+                                          int max_steps = 64);
+
+} // namespace remora

@@ -1,0 +1,492 @@
+#include "remora/remesh/remesh.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+
+#include <nlohmann/json.hpp>
+
+#include "remora/common/error.h"
+#include "remora/common/parallel.h"
+#include "remora/geometry/laplacian.h"
+#include "remora/geometry/locate.h"
+#include "remora/geometry/measures.h"
+
+namespace remora {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double ms_since(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+double mean_edge_length(const Mesh& mesh) {
+  double sum = 0;
+  std::size_t n = 0;
+  for (auto e : mesh.edges()) {
+    sum += mesh.calc_edge_length(e);
+    ++n;
+  }
+  return n ? sum / static_cast<double>(n) : 0.0;
+}
+
+// The boundary halfedge leaving v (invalid for an interior vertex).
+HalfedgeHandle boundary_out(const Mesh& mesh, VertexHandle v) {
+  for (auto h : mesh.voh_range(v))
+    if (mesh.is_boundary(h)) return h;
+  return HalfedgeHandle();
+}
+
+// What each output vertex is allowed to do.
+enum class Kind : std::uint8_t {
+  Interior, // moves tangentially, projected onto the input surface
+  Boundary, // slides along the input boundary
+  Corner,   // never moves (a sharp boundary corner)
+};
+
+class Remesher {
+public:
+  Remesher(const Mesh& input, const RemeshOptions& options)
+      : input_(input), options_(options), mesh_(input) {
+    // Working properties of the private copy; removed before the mesh is handed out.
+    mesh_.add_property(loc_prop_);
+    mesh_.add_property(bloc_prop_);
+    mesh_.add_property(kind_prop_);
+  }
+
+  RemeshResult run() {
+    const auto t_total = Clock::now();
+    RemeshResult result;
+    RemeshReport& report = result.report;
+    const double mean = mean_edge_length(input_);
+    length_ = options_.target_length > 0 ? options_.target_length : options_.length_factor * mean;
+    if (!std::isfinite(length_) || length_ <= 0)
+      throw InvalidArgument("remesh: the target edge length must be positive and finite (got " +
+                            std::to_string(length_) + ")");
+    report.target_length = length_;
+    lo2_ = (0.8 * length_) * (0.8 * length_);
+    hi_ = 4.0 / 3.0 * length_;
+    hi2_ = hi_ * hi_;
+
+    auto t = Clock::now();
+    report.input = mesh_quality(input_);
+    report.symmetry_defect_input = laplacian_symmetry_defect(input_);
+    report.milliseconds["report"] += ms_since(t);
+
+    init_locations();
+    for (int cycle = 0; cycle < options_.cycles; ++cycle) {
+      progress("remesh", cycle, options_.cycles);
+      t = Clock::now();
+      report.splits += split_long_edges();
+      report.milliseconds["split"] += ms_since(t);
+      t = Clock::now();
+      report.collapses += collapse_short_edges();
+      report.milliseconds["collapse"] += ms_since(t);
+      t = Clock::now();
+      report.flips += equalize_valences();
+      report.milliseconds["flip"] += ms_since(t);
+      t = Clock::now();
+      tangential_smoothing();
+      report.milliseconds["smooth"] += ms_since(t);
+    }
+    t = Clock::now();
+    mesh_.garbage_collection();
+    report.milliseconds["collapse"] += ms_since(t);
+
+    t = Clock::now();
+    report.after_cycles = mesh_quality(mesh_);
+    report.symmetry_defect_cycles = laplacian_symmetry_defect(mesh_);
+    report.milliseconds["report"] += ms_since(t);
+
+    t = Clock::now();
+    for (int it = 0; it < options_.equalize_iterations; ++it) {
+      progress("equalize", it, options_.equalize_iterations);
+      equalize_areas();
+    }
+    report.milliseconds["equalize"] += ms_since(t);
+
+    t = Clock::now();
+    report.after_equalization = mesh_quality(mesh_);
+    report.symmetry_defect_output = laplacian_symmetry_defect(mesh_);
+    report.milliseconds["report"] += ms_since(t);
+
+    t = Clock::now();
+    progress("correspondence", 0, 1);
+    result.output_on_input.resize(mesh_.n_vertices());
+    for (auto v : mesh_.vertices()) result.output_on_input[v.idx()] = loc(v);
+    result.input_on_output = locate_input_vertices();
+    report.milliseconds["correspondence"] += ms_since(t);
+
+    mesh_.remove_property(loc_prop_);
+    mesh_.remove_property(bloc_prop_);
+    mesh_.remove_property(kind_prop_);
+    result.mesh = std::move(mesh_);
+    report.milliseconds["total"] = ms_since(t_total);
+    return result;
+  }
+
+private:
+  void progress(std::string_view phase, int step, int steps) const {
+    if (options_.progress) options_.progress(phase, step, steps);
+  }
+
+  // --- the correspondence -------------------------------------------------------------------
+
+  // Every output vertex starts as its input vertex: at a corner of an incident face, and on the
+  // boundary at its outgoing boundary halfedge.
+  void init_locations() {
+    const double corner_cos = std::cos(options_.corner_angle_deg * M_PI / 180.0);
+    for (auto v : mesh_.vertices()) {
+      kind(v) = Kind::Interior;
+      if (mesh_.is_isolated(v)) {
+        kind(v) = Kind::Corner;
+        continue;
+      }
+      // The same handles index the copy and the input.
+      const FaceHandle f = *input_.cvf_begin(v);
+      SurfacePoint sp;
+      sp.face = f;
+      const auto fv = face_vertices(input_, f);
+      sp.bary = {fv[0] == v ? 1.0 : 0.0, fv[1] == v ? 1.0 : 0.0, fv[2] == v ? 1.0 : 0.0};
+      loc(v) = sp;
+      if (mesh_.is_boundary(v)) {
+        kind(v) = Kind::Boundary;
+        const HalfedgeHandle out = boundary_out(input_, v);
+        bloc(v) = out;
+        // The incoming boundary halfedge is prev(out); the boundary turns by the angle between
+        // the two edge directions.
+        const HalfedgeHandle in = input_.prev_halfedge_handle(out);
+        Vec3 d_in = input_.point(v) - input_.point(input_.from_vertex_handle(in));
+        Vec3 d_out = input_.point(input_.to_vertex_handle(out)) - input_.point(v);
+        const double n_in = d_in.norm(), n_out = d_out.norm();
+        if (n_in > 0 && n_out > 0 && OpenMesh::dot(d_in, d_out) / (n_in * n_out) < corner_cos)
+          kind(v) = Kind::Corner;
+        // A vertex where two boundary loops meet would also be pinned here; repaired meshes
+        // have none.
+      }
+    }
+  }
+
+  // Finds where `p` lies on the input, starting from the location of `near`, and returns the
+  // point to place the vertex at (the projection when projecting).
+  Vec3 relocate(VertexHandle v, const Vec3& p, VertexHandle near) {
+    if (kind(near) != Kind::Interior && kind(v) != Kind::Interior) {
+      const BoundaryPoint bp = walk_to_closest_on_boundary(input_, p, bloc(near));
+      loc(v) = bp.point;
+      bloc(v) = bp.halfedge;
+    } else {
+      loc(v) = walk_to_closest(input_, p, loc(near).face);
+    }
+    return options_.project ? evaluate(input_, loc(v)) : p;
+  }
+
+  // Each input vertex's closest point on the output, found by a local walk from the face the
+  // input vertex's own location points to through the output's tracked vertex locations: the
+  // output vertex nearest in index space is not known, so the walk starts from a face around the
+  // output vertex whose input location shares the input vertex's face.
+  std::vector<SurfacePoint> locate_input_vertices() {
+    // Seed: for each input face, an output vertex located in it (any).
+    std::vector<int> seed(input_.n_faces(), -1);
+    for (auto v : mesh_.vertices())
+      if (!mesh_.is_isolated(v)) seed[loc(v).face.idx()] = v.idx();
+    // Spread seeds to faces without one, breadth-first over input face adjacency, so every input
+    // face knows a nearby output vertex.
+    std::vector<int> queue;
+    for (auto f : input_.faces())
+      if (seed[f.idx()] >= 0) queue.push_back(f.idx());
+    for (std::size_t q = 0; q < queue.size(); ++q) {
+      const FaceHandle f(queue[q]);
+      for (auto g : input_.ff_range(f))
+        if (seed[g.idx()] < 0) {
+          seed[g.idx()] = seed[f.idx()];
+          queue.push_back(g.idx());
+        }
+    }
+    std::vector<SurfacePoint> out(input_.n_vertices());
+    parallel_for(input_.n_vertices(), options_.threads, [&](std::size_t i) {
+      const VertexHandle vi(static_cast<int>(i));
+      if (input_.is_isolated(vi)) return;
+      const FaceHandle fi = *input_.cvf_begin(vi);
+      const int s = seed[fi.idx()];
+      if (s < 0) return;
+      const VertexHandle vo(s);
+      const FaceHandle start = *mesh_.cvf_begin(vo);
+      out[i] = walk_to_closest(mesh_, input_.point(vi), start, 256);
+    });
+    return out;
+  }
+
+  // --- the four steps of a cycle -------------------------------------------------------------
+
+  std::size_t split_long_edges() {
+    std::size_t count = 0;
+    for (int pass = 0; pass < 10; ++pass) {
+      std::size_t split_now = 0;
+      const std::size_t n = mesh_.n_edges();
+      for (std::size_t i = 0; i < n; ++i) {
+        const EdgeHandle e(static_cast<int>(i));
+        if (mesh_.status(e).deleted()) continue;
+        const HalfedgeHandle h = mesh_.halfedge_handle(e, 0);
+        const VertexHandle a = mesh_.from_vertex_handle(h), b = mesh_.to_vertex_handle(h);
+        const Vec3 pa = mesh_.point(a), pb = mesh_.point(b);
+        if ((pa - pb).sqrnorm() <= hi2_) continue;
+        const bool on_boundary = mesh_.is_boundary(e);
+        const Vec3 mid = (pa + pb) * 0.5;
+        const VertexHandle v = mesh_.split(e, mid);
+        kind(v) = on_boundary ? Kind::Boundary : Kind::Interior;
+        if (on_boundary) {
+          // Walk the input boundary from an endpoint that lies on it.
+          const VertexHandle from = kind(a) != Kind::Interior ? a : b;
+          mesh_.set_point(v, relocate(v, mid, from));
+        } else {
+          mesh_.set_point(v, relocate(v, mid, a));
+        }
+        ++split_now;
+      }
+      count += split_now;
+      if (split_now == 0) break;
+    }
+    return count;
+  }
+
+  // Would moving `keep` to `p` (after removing `gone`) flip or collapse a face, or create an
+  // edge longer than 4/3 l?
+  bool collapse_is_safe(HalfedgeHandle h, const Vec3& p) {
+    const VertexHandle gone = mesh_.from_vertex_handle(h), keep = mesh_.to_vertex_handle(h);
+    const FaceHandle fl = mesh_.face_handle(h),
+                     fr = mesh_.face_handle(mesh_.opposite_halfedge_handle(h));
+    for (VertexHandle v : {gone, keep}) {
+      for (auto w : mesh_.vv_range(v))
+        if (w != gone && w != keep && (mesh_.point(w) - p).sqrnorm() > hi2_) return false;
+      for (auto f : mesh_.vf_range(v)) {
+        if (f == fl || f == fr) continue;
+        auto fv = face_vertices(mesh_, f);
+        Vec3 q[3];
+        for (int k = 0; k < 3; ++k) q[k] = mesh_.point(fv[k]);
+        const Vec3 n_before = OpenMesh::cross(q[1] - q[0], q[2] - q[0]);
+        for (int k = 0; k < 3; ++k)
+          if (fv[k] == gone || fv[k] == keep) q[k] = p;
+        const Vec3 n_after = OpenMesh::cross(q[1] - q[0], q[2] - q[0]);
+        // The new face must keep its orientation (within 60 degrees) and a non-trivial area.
+        const double before = n_before.norm(), after = n_after.norm();
+        if (after <= 1e-12 * hi2_) return false;
+        if (before > 0 && OpenMesh::dot(n_before, n_after) < 0.5 * before * after) return false;
+      }
+    }
+    return true;
+  }
+
+  std::size_t collapse_short_edges() {
+    std::size_t count = 0;
+    const std::size_t n = mesh_.n_edges();
+    for (std::size_t i = 0; i < n; ++i) {
+      const EdgeHandle e(static_cast<int>(i));
+      if (mesh_.status(e).deleted()) continue;
+      HalfedgeHandle h = mesh_.halfedge_handle(e, 0);
+      VertexHandle a = mesh_.from_vertex_handle(h), b = mesh_.to_vertex_handle(h);
+      if ((mesh_.point(a) - mesh_.point(b)).sqrnorm() >= lo2_) continue;
+      const Kind ka = kind(a), kb = kind(b);
+      // Which endpoint goes, and where the survivor ends up.
+      bool midpoint = true;
+      if (ka == Kind::Corner && kb == Kind::Corner) continue;
+      if (ka != Kind::Interior && kb != Kind::Interior && !mesh_.is_boundary(e)) continue;
+      if (ka == Kind::Corner || (ka == Kind::Boundary && kb == Kind::Interior)) {
+        h = mesh_.opposite_halfedge_handle(h); // remove b, keep a where it is
+        std::swap(a, b);
+        midpoint = false;
+      } else if (kb == Kind::Corner || (kb == Kind::Boundary && ka == Kind::Interior)) {
+        midpoint = false; // remove a, keep b where it is
+      }
+      if (!mesh_.is_collapse_ok(h)) {
+        if (!midpoint) continue;
+        h = mesh_.opposite_halfedge_handle(h);
+        std::swap(a, b);
+        if (!mesh_.is_collapse_ok(h)) continue;
+      }
+      const Vec3 target = midpoint ? (mesh_.point(a) + mesh_.point(b)) * 0.5 : mesh_.point(b);
+      if (!collapse_is_safe(h, target)) continue;
+      mesh_.collapse(h);
+      ++count;
+      if (midpoint) mesh_.set_point(b, relocate(b, target, b));
+    }
+    return count;
+  }
+
+  int target_valence(VertexHandle v) const { return mesh_.is_boundary(v) ? 4 : 6; }
+
+  std::size_t equalize_valences() {
+    std::size_t count = 0;
+    const std::size_t n = mesh_.n_edges();
+    for (std::size_t i = 0; i < n; ++i) {
+      const EdgeHandle e(static_cast<int>(i));
+      if (mesh_.status(e).deleted() || mesh_.is_boundary(e)) continue;
+      const HalfedgeHandle h0 = mesh_.halfedge_handle(e, 0), h1 = mesh_.halfedge_handle(e, 1);
+      const VertexHandle a = mesh_.to_vertex_handle(h0), b = mesh_.to_vertex_handle(h1);
+      const VertexHandle c = mesh_.to_vertex_handle(mesh_.next_halfedge_handle(h0));
+      const VertexHandle d = mesh_.to_vertex_handle(mesh_.next_halfedge_handle(h1));
+      if (c == d) continue;
+      const int va = static_cast<int>(mesh_.valence(a)), vb = static_cast<int>(mesh_.valence(b));
+      const int vc = static_cast<int>(mesh_.valence(c)), vd = static_cast<int>(mesh_.valence(d));
+      const int ta = target_valence(a), tb = target_valence(b), tc = target_valence(c),
+                td = target_valence(d);
+      auto sq = [](int x) { return x * x; };
+      const int before = sq(va - ta) + sq(vb - tb) + sq(vc - tc) + sq(vd - td);
+      const int after = sq(va - 1 - ta) + sq(vb - 1 - tb) + sq(vc + 1 - tc) + sq(vd + 1 - td);
+      if (after >= before || !mesh_.is_flip_ok(e)) continue;
+      if (!flip_keeps_orientation(a, b, c, d)) continue;
+      mesh_.flip(e);
+      ++count;
+    }
+    return count;
+  }
+
+  // The triangles (b, a, c) and (a, b, d) around edge ab become (a, c, d) and (c, b, d): both must
+  // face the way the pair did, and neither may be degenerate.
+  bool flip_keeps_orientation(VertexHandle a, VertexHandle b, VertexHandle c,
+                              VertexHandle d) const {
+    const Vec3 pa = mesh_.point(a), pb = mesh_.point(b), pc = mesh_.point(c), pd = mesh_.point(d);
+    const Vec3 n_old = OpenMesh::cross(pa - pb, pc - pb) + OpenMesh::cross(pb - pa, pd - pa);
+    const Vec3 n1 = OpenMesh::cross(pc - pa, pd - pa);
+    const Vec3 n2 = OpenMesh::cross(pb - pc, pd - pc);
+    const double tiny = 1e-12 * hi2_;
+    if (n1.norm() <= tiny || n2.norm() <= tiny) return false;
+    return OpenMesh::dot(n1, n_old) > 0 && OpenMesh::dot(n2, n_old) > 0 &&
+           OpenMesh::dot(n1, n2) > 0.5 * n1.norm() * n2.norm();
+  }
+
+  // Area-weighted vertex normal (zero for a vertex whose faces all have zero area).
+  Vec3 vertex_normal(VertexHandle v) const {
+    Vec3 n(0, 0, 0);
+    for (auto h : mesh_.voh_range(v)) {
+      if (mesh_.is_boundary(h)) continue;
+      const Vec3 p = mesh_.point(v);
+      const Vec3 q = mesh_.point(mesh_.to_vertex_handle(h));
+      const Vec3 r = mesh_.point(mesh_.to_vertex_handle(mesh_.next_halfedge_handle(h)));
+      n += OpenMesh::cross(q - p, r - p);
+    }
+    const double len = n.norm();
+    return len > 0 ? n / len : Vec3(0, 0, 0);
+  }
+
+  // Moves every vertex by `update(v)` (tangential for interior vertices, along the boundary for
+  // boundary ones), then back onto the input. Two data-parallel phases: all targets are
+  // computed from the current positions, then all vertices move.
+  template <class Target>
+  void move_vertices(Target&& target) {
+    const std::size_t n = mesh_.n_vertices();
+    std::vector<Vec3> goal(n);
+    std::vector<char> moves(n, 0);
+    parallel_for(n, options_.threads, [&](std::size_t i) {
+      const VertexHandle v(static_cast<int>(i));
+      if (mesh_.status(v).deleted() || kind(v) == Kind::Corner || mesh_.is_isolated(v)) return;
+      Vec3 g;
+      if (!target(v, g)) return;
+      goal[i] = g;
+      moves[i] = 1;
+    });
+    parallel_for(n, options_.threads, [&](std::size_t i) {
+      if (!moves[i]) return;
+      const VertexHandle v(static_cast<int>(i));
+      mesh_.set_point(v, relocate(v, goal[i], v));
+    });
+  }
+
+  // Where a boundary vertex goes: the midpoint of its two boundary neighbours, relaxed by
+  // `weight`.
+  bool boundary_target(VertexHandle v, double weight, Vec3& goal) const {
+    const HalfedgeHandle out = boundary_out(mesh_, v);
+    if (!out.is_valid()) return false;
+    const VertexHandle next = mesh_.to_vertex_handle(out);
+    const VertexHandle prev = mesh_.from_vertex_handle(mesh_.prev_halfedge_handle(out));
+    const Vec3 mid = (mesh_.point(next) + mesh_.point(prev)) * 0.5;
+    goal = mesh_.point(v) + (mid - mesh_.point(v)) * weight;
+    return true;
+  }
+
+  void tangential_smoothing() {
+    move_vertices([&](VertexHandle v, Vec3& goal) {
+      if (kind(v) == Kind::Boundary) return boundary_target(v, 0.5, goal);
+      Vec3 centroid(0, 0, 0);
+      int k = 0;
+      for (auto w : mesh_.vv_range(v)) {
+        centroid += mesh_.point(w);
+        ++k;
+      }
+      if (k == 0) return false;
+      const Vec3 p = mesh_.point(v);
+      Vec3 u = centroid / k - p;
+      const Vec3 n = vertex_normal(v);
+      u -= n * OpenMesh::dot(n, u);
+      goal = p + u;
+      return true;
+    });
+  }
+
+  // §4: p_i += λ (I − n nᵀ)(g_i − p_i), g_i the area-weighted centroid of the one-ring.
+  void equalize_areas() {
+    const Eigen::VectorXd area = vertex_areas_mixed(mesh_);
+    move_vertices([&](VertexHandle v, Vec3& goal) {
+      if (kind(v) == Kind::Boundary) return false; // boundary vertices keep their spacing
+      Vec3 g(0, 0, 0);
+      double w = 0;
+      for (auto u : mesh_.vv_range(v)) {
+        g += mesh_.point(u) * area[u.idx()];
+        w += area[u.idx()];
+      }
+      if (!(w > 0)) return false;
+      const Vec3 p = mesh_.point(v);
+      Vec3 d = g / w - p;
+      const Vec3 n = vertex_normal(v);
+      d -= n * OpenMesh::dot(n, d);
+      goal = p + d * options_.lambda;
+      return true;
+    });
+  }
+
+  const Mesh& input_;
+  const RemeshOptions& options_;
+  Mesh mesh_;
+  OpenMesh::VPropHandleT<SurfacePoint> loc_prop_;    // where the vertex lies on the input
+  OpenMesh::VPropHandleT<HalfedgeHandle> bloc_prop_; // boundary vertices: input boundary halfedge
+  OpenMesh::VPropHandleT<Kind> kind_prop_;
+  SurfacePoint& loc(VertexHandle v) { return mesh_.property(loc_prop_, v); }
+  HalfedgeHandle& bloc(VertexHandle v) { return mesh_.property(bloc_prop_, v); }
+  Kind& kind(VertexHandle v) { return mesh_.property(kind_prop_, v); }
+  Kind kind(VertexHandle v) const { return mesh_.property(kind_prop_, v); }
+  double length_ = 0, lo2_ = 0, hi_ = 0, hi2_ = 0;
+};
+
+} // namespace
+
+RemeshResult remesh(const Mesh& input, const RemeshOptions& options) {
+  if (input.n_faces() == 0) throw InvalidArgument("remesh: the input mesh has no faces");
+  if (options.cycles < 0 || options.equalize_iterations < 0 || options.threads < 0)
+    throw InvalidArgument("remesh: cycles, equalize_iterations and threads must be >= 0");
+  if (!std::isfinite(options.target_length) || !(options.length_factor > 0) ||
+      !std::isfinite(options.length_factor))
+    throw InvalidArgument("remesh: the target length and length factor must be finite, and the "
+                          "factor positive");
+  if (!(options.lambda > 0 && options.lambda <= 1))
+    throw InvalidArgument("remesh: lambda must be in (0, 1]");
+  return Remesher(input, options).run();
+}
+
+nlohmann::json to_json(const RemeshReport& r) {
+  return {{"target_length", r.target_length},
+          {"input", to_json(r.input)},
+          {"after_cycles", to_json(r.after_cycles)},
+          {"after_equalization", to_json(r.after_equalization)},
+          {"symmetry_defect",
+           {{"input", r.symmetry_defect_input},
+            {"after_cycles", r.symmetry_defect_cycles},
+            {"output", r.symmetry_defect_output}}},
+          {"splits", r.splits},
+          {"collapses", r.collapses},
+          {"flips", r.flips},
+          {"milliseconds", r.milliseconds}};
+}
+
+} // namespace remora

@@ -1,0 +1,77 @@
+// The area-equalizing isotropic remesher of Botsch & Kobbelt 2004, §4, with the mutual
+// parameterization between input and output tracked through every operation.
+//
+// remesh() returns a new mesh whose edges are close to a target length l, whose vertices have
+// valence close to 6, and whose vertex (mixed Voronoi) areas are nearly equal, so that the
+// Laplacian of Eq. 1 becomes symmetric once every area is replaced by the mean (§5). The input is
+// never modified. Boundaries stay on the input boundary; boundary corners sharper than
+// `corner_angle_deg` stay where they are. Deterministic: the same input and options give the
+// same output, whatever the number of threads.
+#pragma once
+
+#include <functional>
+#include <map>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <nlohmann/json_fwd.hpp>
+
+#include "remora/geometry/quality.h"
+#include "remora/mesh/mesh.h"
+#include "remora/mesh/surface_point.h"
+
+namespace remora {
+
+struct RemeshOptions {
+  /// Absolute target edge length l; when <= 0, l = length_factor × the input's mean edge length
+  /// (the paper: "slightly less than the average").
+  double target_length = 0.0;
+  double length_factor = 0.9;
+  /// Cycles of split (> 4/3 l), collapse (< 4/5 l), valence flips, tangential smoothing.
+  int cycles = 5;
+  /// Iterations of the area-equalizing fine-tuning (§4); 0 skips it.
+  int equalize_iterations = 20;
+  /// Damping factor of the area-equalizing update p += λ (I − nnᵀ)(g − p).
+  double lambda = 0.5;
+  /// Project moved vertices back onto the input surface (true), or only keep updates in the
+  /// tangent plane (the paper's cheaper variant).
+  bool project = true;
+  /// A boundary vertex whose boundary turns by more than this is a corner and never moves.
+  double corner_angle_deg = 30.0;
+  /// Worker threads for the data-parallel passes; 0 = all hardware threads.
+  int threads = 0;
+  /// Called at the start of every phase: (phase name, step, number of steps).
+  std::function<void(std::string_view phase, int step, int steps)> progress;
+};
+
+struct RemeshReport {
+  double target_length = 0.0;
+  MeshQuality input;
+  MeshQuality after_cycles;
+  MeshQuality after_equalization;
+  double symmetry_defect_input = 0.0; ///< laplacian_symmetry_defect() of the input
+  double symmetry_defect_cycles = 0.0;
+  double symmetry_defect_output = 0.0;
+  std::size_t splits = 0, collapses = 0, flips = 0;
+  /// Wall time per phase in milliseconds ("split", "collapse", "flip", "smooth", "equalize",
+  /// "correspondence", "report", "total").
+  std::map<std::string, double> milliseconds;
+};
+
+struct RemeshResult {
+  Mesh mesh;
+  /// For every output vertex (by index): where it lies on the input.
+  std::vector<SurfacePoint> output_on_input;
+  /// For every input vertex (by index): where it lies on the output (its closest point there).
+  std::vector<SurfacePoint> input_on_output;
+  RemeshReport report;
+};
+
+/// Remeshes `input` (a repaired, manifold triangle mesh). Throws InvalidArgument for an empty
+/// mesh, a non-finite or non-positive target length, or negative counts.
+RemeshResult remesh(const Mesh& input, const RemeshOptions& options = {});
+
+nlohmann::json to_json(const RemeshReport& report);
+
+} // namespace remora

@@ -1,0 +1,225 @@
+// The area-equalizing remesher (paper §4): edge lengths in band, area spread shrinking, no
+// flipped or degenerate output triangles, boundaries kept, output on the input, the
+// correspondence in both directions, determinism.
+#include <cmath>
+#include <filesystem>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "remora/common/error.h"
+#include "remora/geometry/closest_point.h"
+#include "remora/geometry/locate.h"
+#include "remora/geometry/measures.h"
+#include "remora/mesh/io.h"
+#include "remora/mesh/primitives.h"
+#include "remora/mesh/topology.h"
+#include "remora/remesh/remesh.h"
+
+namespace remora {
+namespace {
+
+// Fraction of edges with length in [4/5, 4/3] l.
+double fraction_in_band(const Mesh& m, double l) {
+  std::size_t in = 0, all = 0;
+  for (auto e : m.edges()) {
+    const double len = m.calc_edge_length(e);
+    in += (len >= 0.8 * l - 1e-12 && len <= 4.0 / 3.0 * l + 1e-12) ? 1 : 0;
+    ++all;
+  }
+  return static_cast<double>(in) / static_cast<double>(all);
+}
+
+Vec3 face_normal(const Mesh& m, FaceHandle f) {
+  const auto v = face_vertices(m, f);
+  return OpenMesh::cross(m.point(v[1]) - m.point(v[0]), m.point(v[2]) - m.point(v[0]));
+}
+
+// Brute-force distance from p to the surface of m.
+double distance_to(const Mesh& m, const Vec3& p) {
+  double best = std::numeric_limits<double>::infinity();
+  for (auto f : m.faces()) {
+    const auto v = face_vertices(m, f);
+    best = std::min(
+        best, closest_point_on_triangle(p, m.point(v[0]), m.point(v[1]), m.point(v[2])).distance2);
+  }
+  return std::sqrt(best);
+}
+
+// A flat grid whose columns are squeezed towards x = 0: needles everywhere on the left.
+Mesh needle_grid() {
+  Mesh m = make_grid(40, 20, 4.0, 2.0);
+  for (auto v : m.vertices()) {
+    Vec3 p = m.point(v);
+    p[0] = 4.0 * std::pow(p[0] / 4.0, 3.0);
+    m.set_point(v, p);
+  }
+  return m;
+}
+
+void expect_sound_output(const RemeshResult& r, const Mesh& input) {
+  const Mesh& m = r.mesh;
+  ASSERT_GT(m.n_faces(), 0u);
+  for (auto v : m.vertices()) {
+    const Vec3 p = m.point(v);
+    ASSERT_TRUE(std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]));
+    EXPECT_TRUE(m.is_manifold(v));
+  }
+  const double diag = bounding_box_diagonal(input);
+  for (auto f : m.faces())
+    EXPECT_GT(face_area(m, f), 1e-10 * diag * diag) << "degenerate output face " << f.idx();
+  ASSERT_EQ(r.output_on_input.size(), m.n_vertices());
+  ASSERT_EQ(r.input_on_output.size(), input.n_vertices());
+  // Each location evaluates to its point.
+  for (auto v : m.vertices())
+    EXPECT_LT((evaluate(input, r.output_on_input[v.idx()]) - m.point(v)).norm(), 1e-9 * diag);
+  for (auto v : input.vertices()) {
+    const SurfacePoint& sp = r.input_on_output[v.idx()];
+    ASSERT_TRUE(sp.face.is_valid());
+    double sum = 0;
+    for (double b : sp.bary) {
+      EXPECT_GE(b, -1e-12);
+      sum += b;
+    }
+    EXPECT_NEAR(sum, 1.0, 1e-12);
+  }
+}
+
+TEST(Remesh, FlatGridWithNeedlesBecomesIsotropic) {
+  const Mesh input = needle_grid();
+  RemeshOptions opt;
+  opt.target_length = 0.1;
+  const RemeshResult r = remesh(input, opt);
+  expect_sound_output(r, input);
+  EXPECT_GT(fraction_in_band(r.mesh, 0.1), 0.95);
+  for (auto f : r.mesh.faces()) EXPECT_GT(face_normal(r.mesh, f)[2], 0.0) << "flipped face";
+  // Flat: every output vertex stays in the plane, inside the rectangle.
+  for (auto v : r.mesh.vertices()) {
+    const Vec3 p = r.mesh.point(v);
+    EXPECT_NEAR(p[2], 0.0, 1e-12);
+    EXPECT_GE(p[0], -1e-12);
+    EXPECT_LE(p[0], 4.0 + 1e-12);
+  }
+  EXPECT_GT(r.report.input.angles.percent_below_10, 5.0);
+  EXPECT_EQ(r.report.after_equalization.angles.percent_below_10, 0.0);
+  EXPECT_GT(r.report.after_equalization.angles.min_deg, 25.0);
+}
+
+TEST(Remesh, KeepsTheBoundaryAndItsCorners) {
+  const Mesh input = make_grid(30, 30, 3.0, 3.0);
+  RemeshOptions opt;
+  opt.target_length = 0.13;
+  const RemeshResult r = remesh(input, opt);
+  expect_sound_output(r, input);
+  EXPECT_EQ(boundary_loops(r.mesh).size(), 1u);
+  EXPECT_NEAR(surface_area(r.mesh), 9.0, 1e-9);
+  int corners = 0;
+  for (auto v : r.mesh.vertices()) {
+    const Vec3 p = r.mesh.point(v);
+    if (!r.mesh.is_boundary(v)) continue;
+    // On the square's boundary.
+    const double d =
+        std::min({std::abs(p[0]), std::abs(p[0] - 3), std::abs(p[1]), std::abs(p[1] - 3)});
+    EXPECT_LT(d, 1e-12);
+    if ((std::abs(p[0]) < 1e-12 || std::abs(p[0] - 3) < 1e-12) &&
+        (std::abs(p[1]) < 1e-12 || std::abs(p[1] - 3) < 1e-12))
+      ++corners;
+  }
+  EXPECT_EQ(corners, 4);
+}
+
+TEST(Remesh, AnnulusKeepsBothLoops) {
+  const Mesh input = make_annulus(12, 64, 0.5, 1.5);
+  const RemeshResult r = remesh(input);
+  expect_sound_output(r, input);
+  EXPECT_EQ(boundary_loops(r.mesh).size(), 2u);
+  EXPECT_EQ(component_topology(r.mesh)[0].genus, 0);
+  for (auto v : r.mesh.vertices())
+    if (r.mesh.is_boundary(v)) {
+      const double rad = r.mesh.point(v).norm();
+      // On the input's boundary polygons (chords of the circles).
+      EXPECT_TRUE(rad <= 1.5 + 1e-12 && rad >= 0.5 * std::cos(M_PI / 64) - 1e-12) << rad;
+    }
+}
+
+TEST(Remesh, SphereStaysOnTheInputAndEqualizesAreas) {
+  const Mesh input = make_icosphere(4);
+  RemeshOptions opt;
+  opt.target_length = 0.1;
+  const RemeshResult r = remesh(input, opt);
+  expect_sound_output(r, input);
+  const auto& rep = r.report;
+  EXPECT_GT(fraction_in_band(r.mesh, 0.1), 0.97);
+  // Outward and on the input polyhedron.
+  for (auto f : r.mesh.faces()) {
+    const auto v = face_vertices(r.mesh, f);
+    EXPECT_GT(OpenMesh::dot(face_normal(r.mesh, f), r.mesh.point(v[0])), 0.0);
+  }
+  for (int i = 0; i < 200; ++i) {
+    const VertexHandle v(static_cast<int>(i * r.mesh.n_vertices() / 200));
+    EXPECT_LT(distance_to(input, r.mesh.point(v)), 1e-10);
+  }
+  EXPECT_EQ(component_topology(r.mesh)[0].genus, 0);
+  EXPECT_LT(rep.after_equalization.mixed_area.rel_mad, rep.after_cycles.mixed_area.rel_mad);
+  EXPECT_LT(rep.symmetry_defect_output, rep.symmetry_defect_cycles);
+}
+
+TEST(Remesh, CorrespondenceRoundTripOnAFlatMesh) {
+  const Mesh input = needle_grid();
+  RemeshOptions opt;
+  opt.target_length = 0.12;
+  const RemeshResult r = remesh(input, opt);
+  const double diag = bounding_box_diagonal(input);
+  for (auto v : input.vertices()) {
+    // input vertex -> location on the output -> back onto the input.
+    const SurfacePoint& on_out = r.input_on_output[v.idx()];
+    const Vec3 q = evaluate(r.mesh, on_out);
+    const VertexHandle w = face_vertices(r.mesh, on_out.face)[0];
+    const SurfacePoint back = walk_to_closest(input, q, r.output_on_input[w.idx()].face);
+    EXPECT_LT((evaluate(input, back) - input.point(v)).norm(), 1e-6 * diag);
+  }
+}
+
+TEST(Remesh, InputVerticesFindTheirClosestOutputPoint) {
+  const Mesh input = make_icosphere(3);
+  RemeshOptions opt;
+  opt.target_length = 0.15;
+  const RemeshResult r = remesh(input, opt);
+  for (int i = 0; i < 100; ++i) {
+    const VertexHandle v(static_cast<int>(i * input.n_vertices() / 100));
+    const Vec3 q = evaluate(r.mesh, r.input_on_output[v.idx()]);
+    EXPECT_NEAR((q - input.point(v)).norm(), distance_to(r.mesh, input.point(v)), 1e-12);
+  }
+}
+
+TEST(Remesh, IsDeterministicWhateverTheThreadCount) {
+  const Mesh input = needle_grid();
+  RemeshOptions one;
+  one.threads = 1;
+  RemeshOptions two;
+  two.threads = 2;
+  const RemeshResult a = remesh(input, one), b = remesh(input, two), c = remesh(input, two);
+  ASSERT_EQ(a.mesh.n_vertices(), b.mesh.n_vertices());
+  ASSERT_EQ(b.mesh.n_vertices(), c.mesh.n_vertices());
+  for (auto v : a.mesh.vertices()) {
+    EXPECT_EQ(a.mesh.point(v), b.mesh.point(v));
+    EXPECT_EQ(b.mesh.point(v), c.mesh.point(v));
+  }
+}
+
+TEST(Remesh, RejectsBadOptions) {
+  const Mesh input = make_icosphere(1);
+  RemeshOptions opt;
+  opt.lambda = 0;
+  EXPECT_THROW(remesh(input, opt), InvalidArgument);
+  opt = {};
+  opt.target_length = std::nan("");
+  EXPECT_THROW(remesh(input, opt), InvalidArgument);
+  opt = {};
+  opt.cycles = -1;
+  EXPECT_THROW(remesh(input, opt), InvalidArgument);
+  EXPECT_THROW(remesh(Mesh()), InvalidArgument);
+}
+
+} // namespace
+} // namespace remora
