@@ -56,8 +56,8 @@ Eigen::VectorXd laplacian_of(const Mesh& mesh, const std::function<double(const 
 Mesh octahedron() {
   Mesh mesh;
   std::vector<VertexHandle> v;
-  for (const Vec3& p : {Vec3(1, 0, 0), Vec3(-1, 0, 0), Vec3(0, 1, 0), Vec3(0, -1, 0),
-                        Vec3(0, 0, 1), Vec3(0, 0, -1)}) {
+  for (const Vec3& p : {Vec3(1, 0, 0), Vec3(-1, 0, 0), Vec3(0, 1, 0), Vec3(0, -1, 0), Vec3(0, 0, 1),
+                        Vec3(0, 0, -1)}) {
     v.push_back(mesh.add_vertex(p));
   }
   for (int sx = 0; sx < 2; ++sx) {
@@ -160,7 +160,7 @@ TEST(LaplacianWeights, ZeroAreaFacesContributeNothing) {
   ASSERT_EQ(mesh.n_faces(), 4u);
   const Eigen::SparseMatrix<double> W = cotan_weights(mesh);
   EXPECT_TRUE(W.coeffs().allFinite());
-  EXPECT_EQ(W.coeff(a.idx(), b.idx()), 0.0);                 // only the flat face
+  EXPECT_EQ(W.coeff(a.idx(), b.idx()), 0.0);          // only the flat face
   EXPECT_NEAR(W.coeff(a.idx(), m.idx()), 0.5, 1e-15); // 45 degrees at c, 0 from the flat face
   EXPECT_NEAR(W.coeff(m.idx(), c.idx()), 1.0, 1e-15); // 45 at a and 45 at b: (1 + 1) / 2
   EXPECT_EQ(W.coeff(c.idx(), d.idx()), 0.0);
@@ -186,8 +186,7 @@ TEST(LaplacianWeights, NeedlesStayFinite) {
 TEST(LaplacianWeights, DeletedAndIsolatedVerticesHaveEmptyRows) {
   Mesh mesh = make_grid(2, 2, 1.0, 1.0, GridSplit::Uniform);
   const VertexHandle isolated = mesh.add_vertex(Vec3(5, 5, 5));
-  // Face 0 is the lower triangle of cell (0, 0): (0, 1, 4). Corner 1 keeps other faces; deleting
-  // both faces at corner 0 leaves it isolated, and delete_face removes it.
+  // Deleting both faces at the corner vertex 0 leaves it isolated, and delete_face deletes it.
   std::vector<FaceHandle> at_origin;
   for (const FaceHandle f : mesh.vf_range(VertexHandle(0))) at_origin.push_back(f);
   for (const FaceHandle f : at_origin) mesh.delete_face(f, true);

@@ -92,7 +92,8 @@ void add_remesh_command(CLI::App& app) {
       app.add_subcommand("remesh", "Isotropic, area-equalizing remesh (paper section 4) of a mesh");
   struct Args {
     std::string in, out;
-    double length = 0, factor = 0.9, lambda = 0.5;
+    double length = 0, factor = 0.9, lambda = 0.5, smoothing = 1.0;
+    std::string method = "newton";
     int cycles = 5, equalize = 20, threads = 0;
     bool no_project = false, report = false, json = false;
   };
@@ -112,6 +113,12 @@ void add_remesh_command(CLI::App& app) {
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--lambda", a->lambda, "Damping of the area-equalizing update, in (0, 1]")
       ->check(CLI::Range(0.0, 1.0));
+  cmd->add_option("--method", a->method,
+                  "Area equalization: newton (default) or gravity (the paper's update)")
+      ->check(CLI::IsMember({"newton", "gravity"}));
+  cmd->add_option("--smoothing", a->smoothing,
+                  "newton: weight of the shape-keeping smoothing term (default 1)")
+      ->check(CLI::NonNegativeNumber);
   cmd->add_option("--threads", a->threads, "Worker threads (default: all)")
       ->check(CLI::NonNegativeNumber);
   cmd->add_flag("--no-project", a->no_project,
@@ -127,6 +134,8 @@ void add_remesh_command(CLI::App& app) {
     options.cycles = a->cycles;
     options.equalize_iterations = a->equalize;
     options.lambda = a->lambda;
+    options.equalization = a->method == "gravity" ? Equalization::Gravity : Equalization::Newton;
+    options.equalize_smoothing = a->smoothing;
     options.threads = a->threads;
     options.project = !a->no_project;
     ProgressLine progress;

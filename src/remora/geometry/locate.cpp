@@ -97,8 +97,7 @@ BoundaryPoint walk_to_closest_on_boundary(const Mesh& mesh, const Vec3& q, Halfe
     return !mesh.status(h).deleted() && mesh.is_boundary(h) &&
            is_live(mesh, mesh.face_handle(mesh.opposite_halfedge_handle(h)));
   };
-  if (!start.is_valid() || start.idx() >= static_cast<int>(mesh.n_halfedges()) ||
-      !usable(start)) {
+  if (!start.is_valid() || start.idx() >= static_cast<int>(mesh.n_halfedges()) || !usable(start)) {
     throw InvalidArgument("walk_to_closest_on_boundary: halfedge " + std::to_string(start.idx()) +
                           " is not a live boundary halfedge with a face on its other side; pass "
                           "a halfedge h with mesh.is_boundary(h)");
@@ -132,7 +131,9 @@ BoundaryPoint walk_to_closest_on_boundary(const Mesh& mesh, const Vec3& q, Halfe
   const VertexHandle to = mesh.to_vertex_handle(h);
   const std::array<VertexHandle, 3> corners = face_vertices(mesh, result.point.face);
   for (std::size_t k = 0; k < 3; ++k) {
-    result.point.bary[k] = corners[k] == from ? 1.0 - current.t : corners[k] == to ? current.t : 0.0;
+    result.point.bary[k] = corners[k] == from ? 1.0 - current.t
+                           : corners[k] == to ? current.t
+                                              : 0.0;
   }
   return result;
 }

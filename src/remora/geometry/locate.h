@@ -1,10 +1,14 @@
 // Local closest-point search on a triangle mesh: from a face near the answer, walk over the mesh
 // to the closest point in O(1) work per query instead of a global search. The remesher uses it to
 // project vertices back onto the input surface and to carry the correspondence (paper §4).
-// Both walks are greedy descents of the distance to q; they find a local minimum, which is the
-// global one when q lies within a few edge lengths of the surface near `start` and the surface
-// does not fold back there. Deleted faces (status deleted, or halfedges without a face) are never
-// entered. Thread-safe for concurrent calls on the same const mesh; nothing is allocated.
+// Both walks are greedy descents of the distance to q and end in a local minimum. It is the
+// global one when q lies within a few edge lengths of the surface near `start` and away from the
+// surface's medial axis. Otherwise the walk stays on the sheet it started on: on a thin part it
+// does not jump to the other side, and near a concave crease, or inside a solid near a sharp
+// edge, it may stop on the side it reached first (measured for queries 0.5 edge lengths off
+// random faces: 0 to 0.2 % of them on icospheres, grids and scans, 2 % on the CAD part
+// conrod.stl). Deleted faces (status deleted, or halfedges without a face) are never entered.
+// Thread-safe for concurrent calls on the same const mesh; nothing is allocated.
 #pragma once
 
 #include "remora/mesh/mesh.h"
@@ -20,8 +24,7 @@ namespace remora {
 /// >= 0, summing to 1).
 /// Throws InvalidArgument if start is not a face of mesh or is deleted, if q is not finite, or if
 /// max_steps < 0.
-SurfacePoint walk_to_closest(const Mesh& mesh, const Vec3& q, FaceHandle start,
-                             int max_steps = 64);
+SurfacePoint walk_to_closest(const Mesh& mesh, const Vec3& q, FaceHandle start, int max_steps = 64);
 
 /// A point on a boundary edge: `point` lies on the face across `halfedge` (a boundary halfedge,
 /// which has no face) with the barycentric weight of that face's third vertex exactly 0, and

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 
+#include <Eigen/Dense>
 #include <nlohmann/json.hpp>
 
 #include "remora/common/error.h"
@@ -12,6 +13,7 @@
 #include "remora/geometry/laplacian.h"
 #include "remora/geometry/locate.h"
 #include "remora/geometry/measures.h"
+#include "remora/mesh/topology.h"
 
 namespace remora {
 
@@ -138,7 +140,6 @@ private:
   // Every output vertex starts as its input vertex: at a corner of an incident face, and on the
   // boundary at its outgoing boundary halfedge.
   void init_locations() {
-    const double corner_cos = std::cos(options_.corner_angle_deg * M_PI / 180.0);
     for (auto v : mesh_.vertices()) {
       kind(v) = Kind::Interior;
       if (mesh_.is_isolated(v)) {
@@ -154,18 +155,44 @@ private:
       loc(v) = sp;
       if (mesh_.is_boundary(v)) {
         kind(v) = Kind::Boundary;
-        const HalfedgeHandle out = boundary_out(input_, v);
-        bloc(v) = out;
-        // The incoming boundary halfedge is prev(out); the boundary turns by the angle between
-        // the two edge directions.
-        const HalfedgeHandle in = input_.prev_halfedge_handle(out);
-        Vec3 d_in = input_.point(v) - input_.point(input_.from_vertex_handle(in));
-        Vec3 d_out = input_.point(input_.to_vertex_handle(out)) - input_.point(v);
-        const double n_in = d_in.norm(), n_out = d_out.norm();
-        if (n_in > 0 && n_out > 0 && OpenMesh::dot(d_in, d_out) / (n_in * n_out) < corner_cos)
-          kind(v) = Kind::Corner;
-        // A vertex where two boundary loops meet would also be pinned here; repaired meshes
-        // have none.
+        bloc(v) = boundary_out(input_, v);
+      }
+    }
+    mark_corners();
+  }
+
+  // A boundary corner is where the boundary turns sharply at the scale of the target length:
+  // the turn at v is measured between the chords to the boundary points about l/2 before and
+  // after it, so that the zigzag of a scanned hole (sharp at the scale of its own edges) is not
+  // a corner while a CAD corner is; of the vertices around one corner only the sharpest is kept.
+  void mark_corners() {
+    const double corner_cos = std::cos(options_.corner_angle_deg * M_PI / 180.0);
+    const double reach2 = 0.25 * length_ * length_;
+    for (const auto& loop : boundary_loops(input_)) {
+      const std::size_t n = loop.size();
+      if (n < 3) continue;
+      std::vector<VertexHandle> vs(n);
+      for (std::size_t i = 0; i < n; ++i) vs[i] = input_.from_vertex_handle(loop[i]);
+      std::vector<double> turn(n, -2.0); // cosine of the turning angle; lower is sharper
+      std::vector<std::size_t> before(n), after(n);
+      for (std::size_t i = 0; i < n; ++i) {
+        const Vec3 p = input_.point(vs[i]);
+        std::size_t b = (i + n - 1) % n, a = (i + 1) % n;
+        while (b != a && (input_.point(vs[b]) - p).sqrnorm() < reach2) b = (b + n - 1) % n;
+        while (a != b && (input_.point(vs[a]) - p).sqrnorm() < reach2) a = (a + 1) % n;
+        before[i] = b;
+        after[i] = a;
+        const Vec3 d_in = p - input_.point(vs[b]), d_out = input_.point(vs[a]) - p;
+        const double len = d_in.norm() * d_out.norm();
+        turn[i] = len > 0 ? OpenMesh::dot(d_in, d_out) / len : 1.0;
+      }
+      for (std::size_t i = 0; i < n; ++i) {
+        if (turn[i] >= corner_cos) continue;
+        // Non-maximum suppression over the same window (ties go to the lower index).
+        bool sharpest = true;
+        for (std::size_t j = before[i]; j != after[i] && sharpest; j = (j + 1) % n)
+          if (j != i && (turn[j] < turn[i] || (turn[j] == turn[i] && j < i))) sharpest = false;
+        if (sharpest) kind(vs[i]) = Kind::Corner;
       }
     }
   }
@@ -425,8 +452,15 @@ private:
     });
   }
 
-  // §4: p_i += λ (I − n nᵀ)(g_i − p_i), g_i the area-weighted centroid of the one-ring.
   void equalize_areas() {
+    if (options_.equalization == Equalization::Gravity)
+      equalize_areas_gravity();
+    else
+      equalize_areas_newton();
+  }
+
+  // §4: p_i += λ (I − n nᵀ)(g_i − p_i), g_i the area-weighted centroid of the one-ring.
+  void equalize_areas_gravity() {
     const Eigen::VectorXd area = vertex_areas_mixed(mesh_);
     move_vertices([&](VertexHandle v, Vec3& goal) {
       if (kind(v) == Kind::Boundary) return false; // boundary vertices keep their spacing
@@ -442,6 +476,105 @@ private:
       const Vec3 n = vertex_normal(v);
       d -= n * OpenMesh::dot(n, d);
       goal = p + d * options_.lambda;
+      return true;
+    });
+  }
+
+  // A regularized Gauss-Newton step per vertex on the residuals r_j = A_j − Ā (mixed areas) of
+  // the interior vertices of its closed one-ring, in the tangent plane:
+  //   δ_i = −λ (J_iᵀ J_i + μ I)⁻¹ (J_iᵀ r + μ (p_i − c_i)),
+  // J_i = ∂A_j/∂p_i by central differences of the incident faces' mixed-area parts (only those
+  // depend on p_i), c_i the one-ring centroid; the μ term is the tangential smoothing of the
+  // cycles, which keeps triangles well shaped while the areas are pulled to their mean. Unlike
+  // the gravity update, whose fixed point is not an equal-area mesh, r = 0 is (up to μ) this
+  // iteration's fixed point. Jacobi-style (all vertices at once), hence the damping λ.
+  void equalize_areas_newton() {
+    const Eigen::VectorXd area = vertex_areas_mixed(mesh_);
+    double sum = 0;
+    std::size_t count = 0;
+    for (auto v : mesh_.vertices())
+      if (kind(v) == Kind::Interior && !mesh_.is_isolated(v)) {
+        sum += area[v.idx()];
+        ++count;
+      }
+    if (count == 0) return;
+    const double target = sum / static_cast<double>(count);
+    const double eps = 1e-4 * length_;
+    move_vertices([&](VertexHandle v, Vec3& goal) {
+      if (kind(v) != Kind::Interior) return false;
+      const Vec3 p = mesh_.point(v);
+      const Vec3 n = vertex_normal(v);
+      if (n.sqrnorm() == 0) return false;
+      // The one-ring in order: ring[k] = to(h_k); face k = (v, ring[k], ring[k+1]).
+      VertexHandle ring[64];
+      bool face_ok[64];
+      int k = 0;
+      Vec3 centroid(0, 0, 0);
+      for (auto h : mesh_.voh_range(v)) {
+        if (k == 64) return false;
+        ring[k] = mesh_.to_vertex_handle(h);
+        face_ok[k] = !mesh_.is_boundary(h);
+        centroid += mesh_.point(ring[k]);
+        ++k;
+      }
+      if (k < 3) return false;
+      centroid /= k;
+      // Next to the boundary (which does not move here) the area term would squeeze the
+      // boundary triangles: keep to plain tangential smoothing there.
+      bool near_boundary = false;
+      for (int j = 0; j < k; ++j) near_boundary |= kind(ring[j]) != Kind::Interior;
+      if (near_boundary) {
+        Vec3 u = centroid - p;
+        u -= n * OpenMesh::dot(n, u);
+        goal = p + u * options_.lambda;
+        return true;
+      }
+      // Mixed-area parts of v and each ring vertex from the faces around v, for v at q.
+      auto parts = [&](const Vec3& q, double* self, double* nb) {
+        *self = 0;
+        for (int j = 0; j < k; ++j) nb[j] = 0;
+        for (int j = 0; j < k; ++j) {
+          if (!face_ok[j]) continue;
+          const int j1 = (j + 1) % k;
+          const auto m = triangle_mixed_areas(q, mesh_.point(ring[j]), mesh_.point(ring[j1]));
+          *self += m[0];
+          nb[j] += m[1];
+          nb[j1] += m[2];
+        }
+      };
+      Vec3 t1 = OpenMesh::cross(n, std::abs(n[0]) < 0.9 ? Vec3(1, 0, 0) : Vec3(0, 1, 0));
+      t1.normalize();
+      const Vec3 t2 = OpenMesh::cross(n, t1);
+      double sp[65], sm[65], d1[65], d2[65];
+      for (int axis = 0; axis < 2; ++axis) {
+        const Vec3 t = axis == 0 ? t1 : t2;
+        double* d = axis == 0 ? d1 : d2;
+        parts(p + t * eps, &sp[k], sp);
+        parts(p - t * eps, &sm[k], sm);
+        for (int j = 0; j <= k; ++j) d[j] = (sp[j] - sm[j]) / (2 * eps);
+      }
+      // Residuals: the ring's interior vertices and v itself (index k).
+      Eigen::Matrix2d jtj = Eigen::Matrix2d::Zero();
+      Eigen::Vector2d jtr = Eigen::Vector2d::Zero();
+      for (int j = 0; j <= k; ++j) {
+        const VertexHandle w = j == k ? v : ring[j];
+        if (kind(w) != Kind::Interior) continue;
+        const Eigen::Vector2d row(d1[j], d2[j]);
+        jtj += row * row.transpose();
+        jtr += row * (area[w.idx()] - target);
+      }
+      const Vec3 off = p - centroid;
+      const double mu = options_.equalize_smoothing * 0.5 * jtj.trace();
+      jtj(0, 0) += mu;
+      jtj(1, 1) += mu;
+      jtr += mu * Eigen::Vector2d(OpenMesh::dot(off, t1), OpenMesh::dot(off, t2));
+      if (!(jtj.determinant() > 0)) return false;
+      const Eigen::Vector2d step = -jtj.inverse() * jtr * options_.lambda;
+      Vec3 d = t1 * step[0] + t2 * step[1];
+      // Never move by more than a fraction of the target length in one iteration.
+      const double cap = 0.2 * length_;
+      if (d.norm() > cap) d *= cap / d.norm();
+      goal = p + d;
       return true;
     });
   }

@@ -23,6 +23,12 @@
 
 namespace remora {
 
+/// How the fine-tuning equalizes vertex areas (docs/remesh.md compares them).
+enum class Equalization {
+  Gravity, ///< the paper's update: towards the area-weighted centroid of the one-ring
+  Newton,  ///< a damped Gauss-Newton step on the area residuals of the one-ring
+};
+
 struct RemeshOptions {
   /// Absolute target edge length l; when <= 0, l = length_factor × the input's mean edge length
   /// (the paper: "slightly less than the average").
@@ -32,8 +38,11 @@ struct RemeshOptions {
   int cycles = 5;
   /// Iterations of the area-equalizing fine-tuning (§4); 0 skips it.
   int equalize_iterations = 20;
-  /// Damping factor of the area-equalizing update p += λ (I − nnᵀ)(g − p).
+  Equalization equalization = Equalization::Newton;
+  /// Damping factor λ of the area-equalizing update (both methods).
   double lambda = 0.5;
+  /// Newton only: weight μ of the tangential-smoothing term, relative to the area term.
+  double equalize_smoothing = 1.0;
   /// Project moved vertices back onto the input surface (true), or only keep updates in the
   /// tangent plane (the paper's cheaper variant).
   bool project = true;
