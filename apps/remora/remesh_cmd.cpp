@@ -94,7 +94,7 @@ void add_remesh_command(CLI::App& app) {
     std::string in, out;
     double length = 0, factor = 0.9, lambda = 0.5, smoothing = 1.0;
     std::string method = "newton";
-    int cycles = 5, equalize = 20, threads = 0;
+    int cycles = 5, equalize = 10, threads = 0;
     bool no_project = false, report = false, json = false;
   };
   auto a = std::make_shared<Args>();
@@ -109,7 +109,7 @@ void add_remesh_command(CLI::App& app) {
       ->excludes(length);
   cmd->add_option("--cycles", a->cycles, "Split/collapse/flip/smooth cycles (default 5)")
       ->check(CLI::NonNegativeNumber);
-  cmd->add_option("--equalize", a->equalize, "Area-equalizing iterations (default 20)")
+  cmd->add_option("--equalize", a->equalize, "Area-equalizing iterations (default 10)")
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--lambda", a->lambda, "Damping of the area-equalizing update, in (0, 1]")
       ->check(CLI::Range(0.0, 1.0));

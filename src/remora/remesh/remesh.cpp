@@ -10,6 +10,7 @@
 
 #include "remora/common/error.h"
 #include "remora/common/parallel.h"
+#include "remora/geometry/closest_point.h"
 #include "remora/geometry/laplacian.h"
 #include "remora/geometry/locate.h"
 #include "remora/geometry/measures.h"
@@ -69,6 +70,12 @@ public:
       throw InvalidArgument("remesh: the target edge length must be positive and finite (got " +
                             std::to_string(length_) + ")");
     report.target_length = length_;
+    // Bounded work: a remesh at length l has about area / (√3/4 l²) faces. Splitting stops at
+    // eight times that (plus the input's own count), whatever the geometry does.
+    max_faces_ =
+        static_cast<std::size_t>(std::min(1e9, 8.0 * surface_area(input_) /
+                                                   (std::sqrt(3.0) / 4.0 * length_ * length_))) +
+        2 * input_.n_faces();
     lo2_ = (0.8 * length_) * (0.8 * length_);
     hi_ = 4.0 / 3.0 * length_;
     hi2_ = hi_ * hi_;
@@ -205,7 +212,19 @@ private:
       loc(v) = bp.point;
       bloc(v) = bp.halfedge;
     } else {
-      loc(v) = walk_to_closest(input_, p, loc(near).face);
+      // Most moves stay close above the face the vertex was on: when the closest point on that
+      // face is strictly inside it and within l/100, only a sheet of the surface passing closer
+      // than that could be closer, and the walk is skipped.
+      const FaceHandle f = loc(near).face;
+      const auto fv = face_vertices(input_, f);
+      const TriangleClosest c = closest_point_on_triangle(p, input_.point(fv[0]),
+                                                          input_.point(fv[1]), input_.point(fv[2]));
+      constexpr double inside = 1e-6;
+      if (c.bary[0] > inside && c.bary[1] > inside && c.bary[2] > inside &&
+          c.distance2 <= 1e-4 * length_ * length_)
+        loc(v) = SurfacePoint{f, c.bary};
+      else
+        loc(v) = walk_to_closest(input_, p, f);
     }
     return options_.project ? evaluate(input_, loc(v)) : p;
   }
@@ -256,6 +275,7 @@ private:
       for (std::size_t i = 0; i < n; ++i) {
         const EdgeHandle e(static_cast<int>(i));
         if (mesh_.status(e).deleted()) continue;
+        if (mesh_.n_faces() >= max_faces_) return count + split_now;
         const HalfedgeHandle h = mesh_.halfedge_handle(e, 0);
         const VertexHandle a = mesh_.from_vertex_handle(h), b = mesh_.to_vertex_handle(h);
         const Vec3 pa = mesh_.point(a), pb = mesh_.point(b);
@@ -590,6 +610,7 @@ private:
   Kind& kind(VertexHandle v) { return mesh_.property(kind_prop_, v); }
   Kind kind(VertexHandle v) const { return mesh_.property(kind_prop_, v); }
   double length_ = 0, lo2_ = 0, hi_ = 0, hi2_ = 0;
+  std::size_t max_faces_ = 0;
 };
 
 } // namespace

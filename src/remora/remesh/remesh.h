@@ -37,7 +37,7 @@ struct RemeshOptions {
   /// Cycles of split (> 4/3 l), collapse (< 4/5 l), valence flips, tangential smoothing.
   int cycles = 5;
   /// Iterations of the area-equalizing fine-tuning (§4); 0 skips it.
-  int equalize_iterations = 20;
+  int equalize_iterations = 10;
   Equalization equalization = Equalization::Newton;
   /// Damping factor λ of the area-equalizing update (both methods).
   double lambda = 0.5;
