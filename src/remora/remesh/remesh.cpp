@@ -100,10 +100,16 @@ public:
       t = Clock::now();
       tangential_smoothing();
       report.milliseconds["smooth"] += ms_since(t);
+      // Compact after every cycle, so that element counts are live counts (the split pass's
+      // face cap relies on it) and passes do not iterate over deleted elements.
+      t = Clock::now();
+      mesh_.garbage_collection();
+      report.milliseconds["collapse"] += ms_since(t);
     }
+
     t = Clock::now();
-    mesh_.garbage_collection();
-    report.milliseconds["collapse"] += ms_since(t);
+    report.repairs += repair_bad_triangles(options_.repair_angle_deg);
+    report.milliseconds["repair"] += ms_since(t);
 
     t = Clock::now();
     report.after_cycles = mesh_quality(mesh_);
@@ -115,6 +121,8 @@ public:
       progress("equalize", it, options_.equalize_iterations);
       equalize_areas();
     }
+    if (options_.equalize_iterations > 0)
+      report.repairs += repair_bad_triangles(options_.repair_angle_deg);
     report.milliseconds["equalize"] += ms_since(t);
 
     t = Clock::now();
@@ -212,21 +220,55 @@ private:
       loc(v) = bp.point;
       bloc(v) = bp.halfedge;
     } else {
-      // Most moves stay close above the face the vertex was on: when the closest point on that
-      // face is strictly inside it and within l/100, only a sheet of the surface passing closer
-      // than that could be closer, and the walk is skipped.
+      // Most moves stay close above the face the vertex was on, or cross one of its edges:
+      // when the closest point on that face (or on the face across the edge it left by) is
+      // strictly inside it and within l/100, only a sheet of the surface passing closer than
+      // that could be closer, and the full walk is skipped.
       const FaceHandle f = loc(near).face;
-      const auto fv = face_vertices(input_, f);
-      const TriangleClosest c = closest_point_on_triangle(p, input_.point(fv[0]),
-                                                          input_.point(fv[1]), input_.point(fv[2]));
-      constexpr double inside = 1e-6;
-      if (c.bary[0] > inside && c.bary[1] > inside && c.bary[2] > inside &&
-          c.distance2 <= 1e-4 * length_ * length_)
-        loc(v) = SurfacePoint{f, c.bary};
-      else
-        loc(v) = walk_to_closest(input_, p, f);
+      SurfacePoint quick;
+      if (close_inside(p, f, quick)) {
+        loc(v) = quick;
+      } else {
+        const HalfedgeHandle exit = exit_halfedge(f, quick);
+        const FaceHandle g = exit.is_valid()
+                                 ? input_.face_handle(input_.opposite_halfedge_handle(exit))
+                                 : FaceHandle();
+        if (g.is_valid() && close_inside(p, g, quick))
+          loc(v) = quick;
+        else
+          loc(v) = walk_to_closest(input_, p, f);
+      }
     }
     return options_.project ? evaluate(input_, loc(v)) : p;
+  }
+
+  // Is the closest point of face f to p strictly inside f and within l/100 of p? `out` gets it
+  // either way.
+  bool close_inside(const Vec3& p, FaceHandle f, SurfacePoint& out) const {
+    const auto fv = face_vertices(input_, f);
+    const TriangleClosest c =
+        closest_point_on_triangle(p, input_.point(fv[0]), input_.point(fv[1]), input_.point(fv[2]));
+    out = SurfacePoint{f, c.bary};
+    constexpr double inside = 1e-6;
+    return c.bary[0] > inside && c.bary[1] > inside && c.bary[2] > inside &&
+           c.distance2 <= 1e-4 * length_ * length_;
+  }
+
+  // The halfedge of f across which its closest point `sp` left it: the edge opposite the one
+  // corner whose weight vanished (invalid when two vanished, i.e. at a corner).
+  HalfedgeHandle exit_halfedge(FaceHandle f, const SurfacePoint& sp) const {
+    int zero = -1, zeros = 0;
+    for (int k = 0; k < 3; ++k)
+      if (sp.bary[k] <= 0.0) {
+        zero = k;
+        ++zeros;
+      }
+    if (zeros != 1) return HalfedgeHandle();
+    // halfedge_handle(f) runs v0 -> v1, opposite v2; then v1 -> v2 (opposite v0), v2 -> v0.
+    HalfedgeHandle h = input_.halfedge_handle(f);
+    if (zero == 0) h = input_.next_halfedge_handle(h);
+    if (zero == 1) h = input_.prev_halfedge_handle(h);
+    return input_.is_boundary(input_.opposite_halfedge_handle(h)) ? HalfedgeHandle() : h;
   }
 
   // Each input vertex's closest point on the output, found by a local walk from the face the
@@ -332,33 +374,86 @@ private:
     for (std::size_t i = 0; i < n; ++i) {
       const EdgeHandle e(static_cast<int>(i));
       if (mesh_.status(e).deleted()) continue;
-      HalfedgeHandle h = mesh_.halfedge_handle(e, 0);
-      VertexHandle a = mesh_.from_vertex_handle(h), b = mesh_.to_vertex_handle(h);
-      if ((mesh_.point(a) - mesh_.point(b)).sqrnorm() >= lo2_) continue;
-      const Kind ka = kind(a), kb = kind(b);
-      // Which endpoint goes, and where the survivor ends up.
-      bool midpoint = true;
-      if (ka == Kind::Corner && kb == Kind::Corner) continue;
-      if (ka != Kind::Interior && kb != Kind::Interior && !mesh_.is_boundary(e)) continue;
-      if (ka == Kind::Corner || (ka == Kind::Boundary && kb == Kind::Interior)) {
-        h = mesh_.opposite_halfedge_handle(h); // remove b, keep a where it is
-        std::swap(a, b);
-        midpoint = false;
-      } else if (kb == Kind::Corner || (kb == Kind::Boundary && ka == Kind::Interior)) {
-        midpoint = false; // remove a, keep b where it is
-      }
-      if (!mesh_.is_collapse_ok(h)) {
-        if (!midpoint) continue;
-        h = mesh_.opposite_halfedge_handle(h);
-        std::swap(a, b);
-        if (!mesh_.is_collapse_ok(h)) continue;
-      }
-      const Vec3 target = midpoint ? (mesh_.point(a) + mesh_.point(b)) * 0.5 : mesh_.point(b);
-      if (!collapse_is_safe(h, target)) continue;
-      mesh_.collapse(h);
-      ++count;
-      if (midpoint) mesh_.set_point(b, relocate(b, target, b));
+      if (mesh_.calc_edge_sqr_length(e) >= lo2_) continue;
+      count += try_collapse(e) ? 1 : 0;
     }
+    return count;
+  }
+
+  // Collapses e if the rules allow it: corners never go, an interior vertex goes onto a boundary
+  // vertex (which stays put), two boundary vertices merge along a boundary edge only, and the
+  // result passes collapse_is_safe(). Otherwise the survivor moves to the midpoint.
+  bool try_collapse(EdgeHandle e) {
+    HalfedgeHandle h = mesh_.halfedge_handle(e, 0);
+    VertexHandle a = mesh_.from_vertex_handle(h), b = mesh_.to_vertex_handle(h);
+    const Kind ka = kind(a), kb = kind(b);
+    // Which endpoint goes, and where the survivor ends up.
+    bool midpoint = true;
+    if (ka == Kind::Corner && kb == Kind::Corner) return false;
+    if (ka != Kind::Interior && kb != Kind::Interior && !mesh_.is_boundary(e)) return false;
+    if (ka == Kind::Corner || (ka == Kind::Boundary && kb == Kind::Interior)) {
+      h = mesh_.opposite_halfedge_handle(h); // remove b, keep a where it is
+      std::swap(a, b);
+      midpoint = false;
+    } else if (kb == Kind::Corner || (kb == Kind::Boundary && ka == Kind::Interior)) {
+      midpoint = false; // remove a, keep b where it is
+    }
+    if (!mesh_.is_collapse_ok(h)) {
+      if (!midpoint) return false;
+      h = mesh_.opposite_halfedge_handle(h);
+      std::swap(a, b);
+      if (!mesh_.is_collapse_ok(h)) return false;
+    }
+    const Vec3 target = midpoint ? (mesh_.point(a) + mesh_.point(b)) * 0.5 : mesh_.point(b);
+    if (!collapse_is_safe(h, target)) return false;
+    mesh_.collapse(h);
+    if (midpoint) mesh_.set_point(b, relocate(b, target, b));
+    return true;
+  }
+
+  // Triangles whose smallest angle is below `min_deg` (folds and slivers the cycles leave,
+  // typically a handful per 100k): flip their longest edge when that raises the smallest angle of
+  // the pair, else collapse their shortest edge when the collapse rules allow. Sequential, in face
+  // order; the mesh is compacted afterwards.
+  std::size_t repair_bad_triangles(double min_deg) {
+    const double min_rad = min_deg * M_PI / 180.0;
+    std::size_t count = 0;
+    auto min_angle = [&](VertexHandle x, VertexHandle y, VertexHandle z) {
+      const auto a = triangle_angles(mesh_.point(x), mesh_.point(y), mesh_.point(z));
+      return std::min({a[0], a[1], a[2]});
+    };
+    const std::size_t n = mesh_.n_faces();
+    for (std::size_t i = 0; i < n; ++i) {
+      const FaceHandle f(static_cast<int>(i));
+      if (mesh_.status(f).deleted()) continue;
+      // The face's halfedges, opposite its three corners.
+      HalfedgeHandle hs[3];
+      hs[0] = mesh_.halfedge_handle(f);
+      hs[1] = mesh_.next_halfedge_handle(hs[0]);
+      hs[2] = mesh_.next_halfedge_handle(hs[1]);
+      double len[3];
+      for (int k = 0; k < 3; ++k) len[k] = mesh_.calc_edge_sqr_length(hs[k]);
+      const auto fv = face_vertices(mesh_, f);
+      if (min_angle(fv[0], fv[1], fv[2]) >= min_rad) continue;
+      const int longest = static_cast<int>(std::max_element(len, len + 3) - len);
+      const int shortest = static_cast<int>(std::min_element(len, len + 3) - len);
+      const EdgeHandle el = mesh_.edge_handle(hs[longest]);
+      if (!mesh_.is_boundary(el) && mesh_.is_flip_ok(el)) {
+        const HalfedgeHandle h0 = mesh_.halfedge_handle(el, 0), h1 = mesh_.halfedge_handle(el, 1);
+        const VertexHandle a = mesh_.to_vertex_handle(h0), b = mesh_.to_vertex_handle(h1);
+        const VertexHandle c = mesh_.to_vertex_handle(mesh_.next_halfedge_handle(h0));
+        const VertexHandle d = mesh_.to_vertex_handle(mesh_.next_halfedge_handle(h1));
+        const double before = std::min(min_angle(b, a, c), min_angle(a, b, d));
+        const double after = std::min(min_angle(a, c, d), min_angle(c, b, d));
+        if (after > before && flip_keeps_orientation(a, b, c, d)) {
+          mesh_.flip(el);
+          ++count;
+          continue;
+        }
+      }
+      if (try_collapse(mesh_.edge_handle(hs[shortest]))) ++count;
+    }
+    mesh_.garbage_collection();
     return count;
   }
 
@@ -503,7 +598,7 @@ private:
   // A regularized Gauss-Newton step per vertex on the residuals r_j = A_j − Ā (mixed areas) of
   // the interior vertices of its closed one-ring, in the tangent plane:
   //   δ_i = −λ (J_iᵀ J_i + μ I)⁻¹ (J_iᵀ r + μ (p_i − c_i)),
-  // J_i = ∂A_j/∂p_i by central differences of the incident faces' mixed-area parts (only those
+  // J_i = ∂A_j/∂p_i by forward differences of the incident faces' mixed-area parts (only those
   // depend on p_i), c_i the one-ring centroid; the μ term is the tangential smoothing of the
   // cycles, which keeps triangles well shaped while the areas are pulled to their mean. Unlike
   // the gravity update, whose fixed point is not an equal-area mesh, r = 0 is (up to μ) this
@@ -565,13 +660,13 @@ private:
       Vec3 t1 = OpenMesh::cross(n, std::abs(n[0]) < 0.9 ? Vec3(1, 0, 0) : Vec3(0, 1, 0));
       t1.normalize();
       const Vec3 t2 = OpenMesh::cross(n, t1);
-      double sp[65], sm[65], d1[65], d2[65];
+      double base[65], moved[65], d1[65], d2[65];
+      parts(p, &base[k], base);
       for (int axis = 0; axis < 2; ++axis) {
         const Vec3 t = axis == 0 ? t1 : t2;
         double* d = axis == 0 ? d1 : d2;
-        parts(p + t * eps, &sp[k], sp);
-        parts(p - t * eps, &sm[k], sm);
-        for (int j = 0; j <= k; ++j) d[j] = (sp[j] - sm[j]) / (2 * eps);
+        parts(p + t * eps, &moved[k], moved);
+        for (int j = 0; j <= k; ++j) d[j] = (moved[j] - base[j]) / eps;
       }
       // Residuals: the ring's interior vertices and v itself (index k).
       Eigen::Matrix2d jtj = Eigen::Matrix2d::Zero();
@@ -640,6 +735,7 @@ nlohmann::json to_json(const RemeshReport& r) {
           {"splits", r.splits},
           {"collapses", r.collapses},
           {"flips", r.flips},
+          {"repairs", r.repairs},
           {"milliseconds", r.milliseconds}};
 }
 

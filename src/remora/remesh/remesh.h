@@ -46,6 +46,9 @@ struct RemeshOptions {
   /// Project moved vertices back onto the input surface (true), or only keep updates in the
   /// tangent plane (the paper's cheaper variant).
   bool project = true;
+  /// After the cycles and after equalization, triangles with a smaller angle than this get their
+  /// longest edge flipped or shortest edge collapsed where the rules allow.
+  double repair_angle_deg = 25.0;
   /// A boundary vertex whose boundary turns by more than this is a corner and never moves.
   double corner_angle_deg = 30.0;
   /// Worker threads for the data-parallel passes; 0 = all hardware threads.
@@ -63,8 +66,9 @@ struct RemeshReport {
   double symmetry_defect_cycles = 0.0;
   double symmetry_defect_output = 0.0;
   std::size_t splits = 0, collapses = 0, flips = 0;
-  /// Wall time per phase in milliseconds ("split", "collapse", "flip", "smooth", "equalize",
-  /// "correspondence", "report", "total").
+  std::size_t repairs = 0; ///< flips and collapses of triangles below repair_angle_deg
+  /// Wall time per phase in milliseconds ("split", "collapse", "flip", "smooth", "repair",
+  /// "equalize", "correspondence", "report", "total").
   std::map<std::string, double> milliseconds;
 };
 
