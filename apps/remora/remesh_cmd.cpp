@@ -77,8 +77,12 @@ void print_remesh_report(std::ostream& os, const RemeshReport& r) {
       "{:>12.4f}{:>14.4f}{:>14.4f}");
   os << fmt::format("{:<28}{:>12.4f}{:>14.4f}{:>14.4f}\n", "Laplacian symmetry defect",
                     r.symmetry_defect_input, r.symmetry_defect_cycles, r.symmetry_defect_output);
-  os << fmt::format("operations: {} splits, {} collapses, {} flips\n", grouped(r.splits),
-                    grouped(r.collapses), grouped(r.flips));
+  os << fmt::format("distance to the input (of the bounding-box diagonal): vertices mean {:.2e} "
+                    "max {:.2e}, face centroids mean {:.2e} max {:.2e}\n",
+                    r.vertex_distance_mean, r.vertex_distance_max, r.centroid_distance_mean,
+                    r.centroid_distance_max);
+  os << fmt::format("operations: {} splits, {} collapses, {} flips, {} repairs\n",
+                    grouped(r.splits), grouped(r.collapses), grouped(r.flips), grouped(r.repairs));
   std::string times;
   for (const auto& [phase, ms] : r.milliseconds) times += fmt::format("{} {:.0f} ms, ", phase, ms);
   if (!times.empty()) times.resize(times.size() - 2);

@@ -131,6 +131,10 @@ public:
     report.milliseconds["report"] += ms_since(t);
 
     t = Clock::now();
+    measure_distances(report);
+    report.milliseconds["report"] += ms_since(t);
+
+    t = Clock::now();
     progress("correspondence", 0, 1);
     result.output_on_input.resize(mesh_.n_vertices());
     for (auto v : mesh_.vertices()) result.output_on_input[v.idx()] = loc(v);
@@ -240,6 +244,36 @@ private:
       }
     }
     return options_.project ? evaluate(input_, loc(v)) : p;
+  }
+
+  // How far the output lies from the input: its vertices (tracked locations) and its faces'
+  // centroids (located by a walk from a corner's location).
+  void measure_distances(RemeshReport& report) {
+    const double diag = bounding_box_diagonal(input_);
+    if (!(diag > 0)) return;
+    std::vector<double> vd(mesh_.n_vertices(), 0.0), fd(mesh_.n_faces(), 0.0);
+    parallel_for(mesh_.n_vertices(), options_.threads, [&](std::size_t i) {
+      const VertexHandle v(static_cast<int>(i));
+      if (!mesh_.is_isolated(v)) vd[i] = (mesh_.point(v) - evaluate(input_, loc(v))).norm();
+    });
+    parallel_for(mesh_.n_faces(), options_.threads, [&](std::size_t i) {
+      const auto fv = face_vertices(mesh_, FaceHandle(static_cast<int>(i)));
+      const Vec3 c = (mesh_.point(fv[0]) + mesh_.point(fv[1]) + mesh_.point(fv[2])) / 3.0;
+      const SurfacePoint sp = walk_to_closest(input_, c, loc(fv[0]).face);
+      fd[i] = (c - evaluate(input_, sp)).norm();
+    });
+    auto summarize = [&](const std::vector<double>& d, double& mean, double& max) {
+      double sum = 0;
+      max = 0;
+      for (double x : d) {
+        sum += x;
+        max = std::max(max, x);
+      }
+      mean = d.empty() ? 0.0 : sum / static_cast<double>(d.size()) / diag;
+      max /= diag;
+    };
+    summarize(vd, report.vertex_distance_mean, report.vertex_distance_max);
+    summarize(fd, report.centroid_distance_mean, report.centroid_distance_max);
   }
 
   // Is the closest point of face f to p strictly inside f and within l/100 of p? `out` gets it
@@ -732,6 +766,11 @@ nlohmann::json to_json(const RemeshReport& r) {
            {{"input", r.symmetry_defect_input},
             {"after_cycles", r.symmetry_defect_cycles},
             {"output", r.symmetry_defect_output}}},
+          {"distance_to_input",
+           {{"vertex_mean", r.vertex_distance_mean},
+            {"vertex_max", r.vertex_distance_max},
+            {"centroid_mean", r.centroid_distance_mean},
+            {"centroid_max", r.centroid_distance_max}}},
           {"splits", r.splits},
           {"collapses", r.collapses},
           {"flips", r.flips},

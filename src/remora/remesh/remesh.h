@@ -65,6 +65,10 @@ struct RemeshReport {
   double symmetry_defect_input = 0.0; ///< laplacian_symmetry_defect() of the input
   double symmetry_defect_cycles = 0.0;
   double symmetry_defect_output = 0.0;
+  /// Distances of the output to the input, relative to the input's bounding-box diagonal: of the
+  /// output vertices (0 when projecting) and of the output faces' centroids (the chord error).
+  double vertex_distance_mean = 0.0, vertex_distance_max = 0.0;
+  double centroid_distance_mean = 0.0, centroid_distance_max = 0.0;
   std::size_t splits = 0, collapses = 0, flips = 0;
   std::size_t repairs = 0; ///< flips and collapses of triangles below repair_angle_deg
   /// Wall time per phase in milliseconds ("split", "collapse", "flip", "smooth", "repair",
