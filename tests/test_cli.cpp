@@ -142,5 +142,36 @@ TEST_F(Cli, FailedConvertLeavesNoFile) {
         << "left behind: " << entry.path();
 }
 
+TEST_F(Cli, RemeshWritesTheMeshAndAReportThatAgreesWithIt) {
+  const fs::path in = dir_ / "sphere.off";
+  write_mesh(in.string(), make_icosphere(3));
+  const fs::path out = dir_ / "remeshed.obj";
+  const CliRun r = run("remesh " + in.string() + " -o " + out.string() + " --length 0.2 --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  const LoadResult back = read_mesh(out.string());
+  EXPECT_EQ(j["after_equalization"]["faces"], back.mesh.n_faces());
+  EXPECT_EQ(j["target_length"], 0.2);
+  EXPECT_EQ(j["distance_to_input"]["vertex_max"], 0.0);
+  const CliRun table = run("remesh " + in.string() + " -o " + out.string() + " --report");
+  ASSERT_EQ(table.exit_code, 0) << table.err;
+  EXPECT_NE(table.out.find("Laplacian symmetry defect"), std::string::npos) << table.out;
+}
+
+TEST_F(Cli, RemeshRejectsBadOptionsBeforeWorking) {
+  const fs::path in = dir_ / "sphere.off";
+  write_mesh(in.string(), make_icosphere(1));
+  EXPECT_EQ(
+      run("remesh " + in.string() + " -o " + (dir_ / "o.obj").string() + " --lambda 2").exit_code,
+      2);
+  EXPECT_EQ(run("remesh " + in.string() + " -o " + (dir_ / "o.obj").string() +
+                " --length 1 --length-factor 2")
+                .exit_code,
+            2);
+  EXPECT_EQ(run("remesh " + in.string() + " -o " + (dir_ / "o.xyz").string()).exit_code, 1);
+  for (const auto& entry : fs::directory_iterator(dir_))
+    EXPECT_EQ(entry.path().filename(), "sphere.off") << "left behind: " << entry.path();
+}
+
 } // namespace
 } // namespace remora

@@ -223,6 +223,26 @@ TEST(Remesh, IsDeterministicWhateverTheThreadCount) {
   }
 }
 
+TEST(Remesh, WithoutProjectionVerticesStayNearTheInput) {
+  const Mesh input = make_icosphere(4);
+  RemeshOptions opt;
+  opt.target_length = 0.1;
+  opt.project = false;
+  const RemeshResult r = remesh(input, opt);
+  const RemeshReport& rep = r.report;
+  EXPECT_GT(rep.vertex_distance_max, 0.0); // off the polyhedron: tangent-plane moves only
+  EXPECT_LT(rep.vertex_distance_max, 4e-3);
+  EXPECT_LT(rep.vertex_distance_mean, 1e-3);
+  // The tracked locations are the vertices' closest points on the input.
+  for (int i = 0; i < 100; ++i) {
+    const VertexHandle v(static_cast<int>(i * r.mesh.n_vertices() / 100));
+    EXPECT_NEAR((evaluate(input, r.output_on_input[v.idx()]) - r.mesh.point(v)).norm(),
+                distance_to(input, r.mesh.point(v)), 1e-12);
+  }
+  opt.project = true;
+  EXPECT_EQ(remesh(input, opt).report.vertex_distance_max, 0.0);
+}
+
 TEST(Remesh, RejectsBadOptions) {
   const Mesh input = make_icosphere(1);
   RemeshOptions opt;
