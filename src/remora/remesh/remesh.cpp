@@ -76,6 +76,7 @@ public:
         static_cast<std::size_t>(std::min(1e9, 8.0 * surface_area(input_) /
                                                    (std::sqrt(3.0) / 4.0 * length_ * length_))) +
         2 * input_.n_faces();
+    live_faces_ = mesh_.n_faces();
     lo2_ = (0.8 * length_) * (0.8 * length_);
     hi_ = 4.0 / 3.0 * length_;
     hi2_ = hi_ * hi_;
@@ -100,12 +101,10 @@ public:
       t = Clock::now();
       tangential_smoothing();
       report.milliseconds["smooth"] += ms_since(t);
-      // Compact after every cycle, so that element counts are live counts (the split pass's
-      // face cap relies on it) and passes do not iterate over deleted elements.
-      t = Clock::now();
-      mesh_.garbage_collection();
-      report.milliseconds["collapse"] += ms_since(t);
     }
+    t = Clock::now();
+    mesh_.garbage_collection();
+    report.milliseconds["collapse"] += ms_since(t);
 
     t = Clock::now();
     report.repairs += repair_bad_triangles(options_.repair_angle_deg);
@@ -351,7 +350,7 @@ private:
       for (std::size_t i = 0; i < n; ++i) {
         const EdgeHandle e(static_cast<int>(i));
         if (mesh_.status(e).deleted()) continue;
-        if (mesh_.n_faces() >= max_faces_) return count + split_now;
+        if (live_faces_ >= max_faces_) return count + split_now;
         const HalfedgeHandle h = mesh_.halfedge_handle(e, 0);
         const VertexHandle a = mesh_.from_vertex_handle(h), b = mesh_.to_vertex_handle(h);
         const Vec3 pa = mesh_.point(a), pb = mesh_.point(b);
@@ -359,6 +358,7 @@ private:
         const bool on_boundary = mesh_.is_boundary(e);
         const Vec3 mid = (pa + pb) * 0.5;
         const VertexHandle v = mesh_.split(e, mid);
+        live_faces_ += on_boundary ? 1 : 2;
         kind(v) = on_boundary ? Kind::Boundary : Kind::Interior;
         if (on_boundary) {
           // Walk the input boundary from an endpoint that lies on it.
@@ -440,6 +440,7 @@ private:
     }
     const Vec3 target = midpoint ? (mesh_.point(a) + mesh_.point(b)) * 0.5 : mesh_.point(b);
     if (!collapse_is_safe(h, target)) return false;
+    live_faces_ -= mesh_.is_boundary(e) ? 1 : 2;
     mesh_.collapse(h);
     if (midpoint) mesh_.set_point(b, relocate(b, target, b));
     return true;
@@ -488,6 +489,7 @@ private:
       if (try_collapse(mesh_.edge_handle(hs[shortest]))) ++count;
     }
     mesh_.garbage_collection();
+    live_faces_ = mesh_.n_faces();
     return count;
   }
 
@@ -740,6 +742,7 @@ private:
   Kind kind(VertexHandle v) const { return mesh_.property(kind_prop_, v); }
   double length_ = 0, lo2_ = 0, hi_ = 0, hi2_ = 0;
   std::size_t max_faces_ = 0;
+  std::size_t live_faces_ = 0; // faces not deleted (the mesh is compacted only between phases)
 };
 
 } // namespace
