@@ -299,6 +299,31 @@ TEST_P(RemeshData, MeetsThePapersAreaFigures) {
   }
 }
 
+// Needles, zero-area faces, sharp creases, holes, several bodies: a sound mesh, no NaN, no stall.
+class RemeshUglyData : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(RemeshUglyData, GivesASoundMesh) {
+  const std::string path = shared_mesh(GetParam());
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " not present";
+  const Mesh input = read_mesh(path).mesh;
+  const RemeshResult r = remesh(input);
+  expect_sound_output(r, input);
+  EXPECT_EQ(connected_components(r.mesh).count, connected_components(input).count);
+  EXPECT_EQ(boundary_loops(r.mesh).size(), boundary_loops(input).size());
+  EXPECT_LT(r.report.after_equalization.mixed_area.rel_mad,
+            r.report.after_cycles.mixed_area.rel_mad);
+}
+
+INSTANTIATE_TEST_SUITE_P(CiMeshes, RemeshUglyData,
+                         ::testing::Values("cad/conrod.stl", "cad/featuretype.STL", "cad/gears.stl",
+                                           "open/camelhead.off", "heightfield/AcrossRiver.stl"),
+                         [](const ::testing::TestParamInfo<const char*>& param) {
+                           std::string label = param.param;
+                           for (char& c : label)
+                             if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+                           return label;
+                         });
+
 INSTANTIATE_TEST_SUITE_P(ClosedMeshes, RemeshData,
                          ::testing::Values("cad/fandisk.obj", "genus/fertility.off"),
                          [](const ::testing::TestParamInfo<const char*>& param) {
