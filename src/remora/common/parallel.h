@@ -4,13 +4,17 @@
 
 #include <cstddef>
 
+#include <omp.h>
+
 namespace remora {
 
-/// Runs body(i) for i in [0, n) on `threads` threads (0 = all hardware threads).
+/// Runs body(i) for i in [0, n) on `threads` threads (0 = all hardware threads). Small loops run
+/// on the calling thread.
 template <class Body>
 void parallel_for(std::size_t n, int threads, Body&& body) {
   const long count = static_cast<long>(n);
-#pragma omp parallel for schedule(static) num_threads(threads) if (threads != 1 && n > 1024)
+  const int team = threads > 0 ? threads : omp_get_max_threads();
+#pragma omp parallel for schedule(static) num_threads(team) if (team > 1 && n > 1024)
   for (long i = 0; i < count; ++i) body(static_cast<std::size_t>(i));
 }
 
