@@ -10,6 +10,7 @@
 #include <unordered_set>
 
 #include "remora/common/error.h"
+#include "remora/mesh/build.h"
 
 namespace remora {
 
@@ -578,13 +579,13 @@ private:
   // triangle), which never fails and is faster than incremental add_face().
   RepairResult build() {
     RepairResult result;
-    Mesh& mesh = result.mesh;
-    mesh.reserve(out_points_.size(), group_start_.size(), tris_.size());
-    std::vector<VertexHandle> handle(out_points_.size());
+    std::vector<std::uint32_t> index(out_points_.size(), kNone);
+    std::vector<Vec3> points;
     std::vector<std::uint32_t> copies(points_.size(), 0); // output vertices per welded vertex
     for (std::size_t v = 0; v < out_points_.size(); ++v) {
       if (!vertex_taken_[v]) continue;
-      handle[v] = mesh.new_vertex(out_points_[v]);
+      index[v] = static_cast<std::uint32_t>(points.size());
+      points.push_back(out_points_[v]);
       result.source_vertex.push_back(out_source_[v]);
       ++copies[origin_of(static_cast<std::uint32_t>(v))];
     }
@@ -595,47 +596,17 @@ private:
         report_.vertices_added_by_split += c - 1;
       }
     }
-    // One edge per group of sides (one or two, of opposite directions), in sorted order.
-    std::vector<HalfedgeHandle> side_halfedge(tris_.size() * 3); // by 3*t + corner
-    for (std::size_t g = 0; g + 1 < group_start_.size(); ++g) {
-      const std::uint32_t b = group_start_[g], e = group_start_[g + 1];
-      const EdgeSide& s0 = sides_[b];
-      const Tri& t0 = tris_[s0.tri];
-      const HalfedgeHandle h =
-          mesh.new_edge(handle[t0[s0.corner]], handle[t0[(s0.corner + 1) % 3]]);
-      side_halfedge[3 * s0.tri + s0.corner] = h;
-      for (std::uint32_t i = b + 1; i < e; ++i)
-        side_halfedge[3 * sides_[i].tri + sides_[i].corner] = mesh.opposite_halfedge_handle(h);
+    for (Tri& t : tris_)
+      for (std::uint32_t& v : t) v = index[v];
+    try {
+      result.mesh = build_mesh(points, tris_);
+    } catch (const InvalidArgument& e) {
+      // The steps above guarantee the precondition.
+      throw Error(std::string("internal error in the soup repair: ") + e.what());
     }
-    for (std::uint32_t t = 0; t < tris_.size(); ++t) {
-      const FaceHandle fh = mesh.new_face();
-      const HalfedgeHandle* hs = &side_halfedge[3 * t];
-      for (int k = 0; k < 3; ++k) {
-        mesh.set_face_handle(hs[k], fh);
-        mesh.set_next_halfedge_handle(hs[k], hs[(k + 1) % 3]);
-        mesh.set_halfedge_handle(handle[tris_[t][k]], hs[k]);
-      }
-      mesh.set_halfedge_handle(fh, hs[0]);
-    }
-    // Boundary halfedges: each vertex has at most one outgoing one, which follows the incoming
-    // one around the hole. A boundary vertex's halfedge is its outgoing boundary halfedge
-    // (OpenMesh's convention, which its boundary queries rely on).
-    std::vector<HalfedgeHandle> boundary_out(mesh.n_vertices());
-    for (auto h : mesh.halfedges())
-      if (mesh.is_boundary(h)) {
-        HalfedgeHandle& slot = boundary_out[mesh.from_vertex_handle(h).idx()];
-        if (slot.is_valid()) throw Error("internal error: a repaired vertex has two fans");
-        slot = h;
-      }
-    for (auto h : mesh.halfedges())
-      if (mesh.is_boundary(h))
-        mesh.set_next_halfedge_handle(h, boundary_out[mesh.to_vertex_handle(h).idx()]);
-    for (auto v : mesh.vertices())
-      if (boundary_out[v.idx()].is_valid()) mesh.set_halfedge_handle(v, boundary_out[v.idx()]);
-
-    report_.vertices_loaded = mesh.n_vertices();
-    report_.faces_loaded = mesh.n_faces();
-    report_.zero_area_faces = count_zero_area_faces(mesh);
+    report_.vertices_loaded = result.mesh.n_vertices();
+    report_.faces_loaded = result.mesh.n_faces();
+    report_.zero_area_faces = count_zero_area_faces(result.mesh);
     result.report = report_;
     return result;
   }
