@@ -1,20 +1,28 @@
 # Remora's two entry points: `make demo` and `make test`. Both install what is missing
-# (scripts/bootstrap.sh), configure and build.
+# (scripts/bootstrap.sh), configure and build. `make bench` runs the benchmarks, including the
+# remeshing race against CGAL, which is GPL and therefore only ever built by that target.
 BUILD      ?= build
 ASAN_BUILD ?= build-asan
 JOBS       ?= $(shell nproc)
 CMAKE_FLAGS ?=
 DEMO_MESH  ?= data/bunny.ply
+BENCH_ARGS ?=
 
-.PHONY: all deps build demo test test-release test-asan format format-check clean
+.PHONY: all deps deps-bench build demo test test-release test-asan bench format format-check clean
 
 all: build
 
 deps:
 	@scripts/bootstrap.sh
 
+deps-bench:
+	@scripts/bootstrap.sh --bench
+
+# REMORA_WITH_CGAL=OFF is explicit so that a build folder `make bench` configured goes back to
+# the CGAL-free default.
 build: deps
-	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release -DREMORA_WERROR=ON $(CMAKE_FLAGS)
+	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release -DREMORA_WERROR=ON -DREMORA_WITH_CGAL=OFF \
+	  $(CMAKE_FLAGS)
 	cmake --build $(BUILD) -j$(JOBS)
 
 demo: build
@@ -33,6 +41,15 @@ test-asan: deps
 	cmake --build $(ASAN_BUILD) -j$(JOBS)
 	cd $(ASAN_BUILD) && REMORA_SANITIZED=1 ASAN_OPTIONS=detect_leaks=1 \
 	  UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 ctest --output-on-failure -j$(JOBS)
+
+# Release build with the CGAL race, then loading speed (remora_bench) and the race
+# (remora_bench_remesh). BENCH_ARGS go to the race, e.g. make bench BENCH_ARGS="--large --json".
+bench: deps-bench
+	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release -DREMORA_WERROR=ON -DREMORA_BUILD_BENCH=ON \
+	  -DREMORA_WITH_CGAL=ON $(CMAKE_FLAGS)
+	cmake --build $(BUILD) -j$(JOBS)
+	$(BUILD)/bench/remora_bench
+	$(BUILD)/bench/remora_bench_remesh $(BENCH_ARGS)
 
 FORMAT_FILES = $(shell git ls-files '*.h' '*.cpp')
 

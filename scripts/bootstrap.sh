@@ -1,7 +1,22 @@
 #!/usr/bin/env bash
 # Installs the Debian packages Remora builds and tests with, if any is missing.
 # As root it runs apt-get; otherwise it prints the exact command and stops (exit 1).
+#
+#   scripts/bootstrap.sh           the packages of the default build (make build/test/demo)
+#   scripts/bootstrap.sh --bench   those plus the benchmark-only ones (make bench): libcgal-dev,
+#                                  for the remeshing race against CGAL (GPL; never in the library)
 set -euo pipefail
+
+bench=0
+for arg in "$@"; do
+  case "$arg" in
+    --bench) bench=1 ;;
+    *)
+      echo "bootstrap: unknown argument '$arg' (usage: scripts/bootstrap.sh [--bench])" >&2
+      exit 2
+      ;;
+  esac
+done
 
 packages=(
   build-essential cmake pkg-config clang-format
@@ -10,6 +25,9 @@ packages=(
   libcli11-dev nlohmann-json3-dev libspdlog-dev libfmt-dev libcpp-httplib-dev
   libgtest-dev libgmock-dev libbenchmark-dev
 )
+if [ "$bench" -eq 1 ]; then
+  packages+=(libcgal-dev)
+fi
 
 missing=()
 for p in "${packages[@]}"; do
