@@ -39,6 +39,7 @@
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
 
+#include "remora/geometry/measures.h"
 #include "remora/geometry/quality.h"
 #include "remora/mesh/io.h"
 #include "remora/remesh/remesh.h"
@@ -128,17 +129,6 @@ remora::Mesh from_cgal(const SurfaceMesh& sm) {
 
 // ---------------------------------------------------------------------------------------------
 // Figures
-
-// remesh()'s own definition of the mean edge length: over the edges of the loaded mesh.
-double mean_edge_length(const remora::Mesh& mesh) {
-  double sum = 0;
-  std::size_t n = 0;
-  for (auto e : mesh.edges()) {
-    sum += mesh.calc_edge_length(e);
-    ++n;
-  }
-  return n ? sum / static_cast<double>(n) : 0.0;
-}
 
 struct Segment {
   remora::Vec3 a, b;
@@ -265,7 +255,7 @@ void race(MeshRace& r, const Args& args) {
   r.input_faces = input.n_faces();
   r.input_vertices = input.n_vertices();
   r.input_boundary_loops = remora::mesh_quality(input).boundary_loops;
-  const double l = kLengthFactor * mean_edge_length(input);
+  const double l = kLengthFactor * remora::mean_edge_length(input);
   r.target_length = l;
 
   remora::RemeshOptions eq_options;

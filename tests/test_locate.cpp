@@ -366,12 +366,6 @@ FaceHandle face_rings_away(const Mesh& mesh, FaceHandle f, int rings, std::mt199
   return frontier[rng() % frontier.size()];
 }
 
-double mean_edge_length(const Mesh& mesh) {
-  double sum = 0.0;
-  for (const EdgeHandle e : mesh.edges()) sum += mesh.calc_edge_length(e);
-  return sum / static_cast<double>(mesh.n_edges());
-}
-
 /// A random point on a random live face.
 Vec3 random_surface_point(const Mesh& mesh, std::mt19937& rng, FaceHandle& face) {
   do {

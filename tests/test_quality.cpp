@@ -96,6 +96,15 @@ void expect_all_finite(const nlohmann::json& j, const std::string& path = "") {
 // ---------------------------------------------------------------------------------------------
 // Measures
 
+TEST(MeasuresEdges, MeanEdgeLength) {
+  EXPECT_NEAR(mean_edge_length(make_equilateral_grid(5, 4, 0.3)), 0.3, 1e-15);
+  // A unit cube of 2x2 quads per side: 48 sides of 0.5 along the cube's edges and faces, 24
+  // diagonals of 0.5 * sqrt(2).
+  EXPECT_NEAR(mean_edge_length(make_cube(2, 1.0)), (48 * 0.5 + 24 * 0.5 * std::sqrt(2.0)) / 72,
+              1e-15);
+  EXPECT_EQ(mean_edge_length(Mesh()), 0.0);
+}
+
 TEST(MeasuresTriangle, AreaOfHandComputedTriangles) {
   EXPECT_DOUBLE_EQ(triangle_area(Vec3(0, 0, 0), Vec3(4, 0, 0), Vec3(0, 3, 0)), 6.0);
   // (b - a) x (c - a) = (3, 4, 0) x (0, 0, 5) = (20, -15, 0): |.| / 2 = 12.5.

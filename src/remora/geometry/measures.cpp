@@ -140,4 +140,14 @@ bool is_zero_area(double area, double bbox_diagonal) {
   return area <= kZeroAreaRelative * bbox_diagonal * bbox_diagonal;
 }
 
+double mean_edge_length(const Mesh& mesh) {
+  double sum = 0.0;
+  std::size_t n = 0;
+  for (auto e : mesh.edges()) {
+    sum += mesh.calc_edge_length(e);
+    ++n;
+  }
+  return n > 0 ? sum / static_cast<double>(n) : 0.0;
+}
+
 } // namespace remora

@@ -49,6 +49,10 @@ Eigen::VectorXd vertex_areas_mixed(const Mesh& mesh);
 
 /// Axis-aligned bounding box of all non-deleted vertices (isolated ones included). A mesh without
 /// vertices gives min = max = (0, 0, 0).
+/// Mean length of the mesh's edges (0 for a mesh without edges). remesh() derives its default
+/// target length from it.
+double mean_edge_length(const Mesh& mesh);
+
 struct BoundingBox {
   Vec3 min{0.0, 0.0, 0.0};
   Vec3 max{0.0, 0.0, 0.0};

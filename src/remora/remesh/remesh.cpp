@@ -27,16 +27,6 @@ double ms_since(Clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 }
 
-double mean_edge_length(const Mesh& mesh) {
-  double sum = 0;
-  std::size_t n = 0;
-  for (auto e : mesh.edges()) {
-    sum += mesh.calc_edge_length(e);
-    ++n;
-  }
-  return n ? sum / static_cast<double>(n) : 0.0;
-}
-
 // The boundary halfedge leaving v (invalid for an interior vertex).
 HalfedgeHandle boundary_out(const Mesh& mesh, VertexHandle v) {
   for (auto h : mesh.voh_range(v))
@@ -65,6 +55,12 @@ public:
     const auto t_total = Clock::now();
     RemeshResult result;
     RemeshReport& report = result.report;
+    // Runs f and adds its wall time to the phase's entry of the report.
+    auto timed = [&report](const char* phase, auto&& f) {
+      const auto t0 = Clock::now();
+      f();
+      report.milliseconds[phase] += ms_since(t0);
+    };
     const double mean = mean_edge_length(input_);
     length_ = options_.target_length > 0 ? options_.target_length : options_.length_factor * mean;
     if (!std::isfinite(length_) || length_ <= 0)
@@ -82,69 +78,47 @@ public:
     hi_ = 4.0 / 3.0 * length_;
     hi2_ = hi_ * hi_;
 
-    auto t = Clock::now();
-    report.input = mesh_quality(input_);
-    report.symmetry_defect_input = laplacian_symmetry_defect(input_);
-    report.milliseconds["report"] += ms_since(t);
+    timed("report", [&] {
+      report.input = mesh_quality(input_);
+      report.symmetry_defect_input = laplacian_symmetry_defect(input_);
+    });
 
     init_locations();
     for (int cycle = 0; cycle < options_.cycles; ++cycle) {
       progress("remesh", cycle, options_.cycles);
-      t = Clock::now();
-      report.splits += split_long_edges();
-      report.milliseconds["split"] += ms_since(t);
-      t = Clock::now();
-      report.collapses += collapse_short_edges();
-      report.milliseconds["collapse"] += ms_since(t);
-      t = Clock::now();
-      report.flips += equalize_valences();
-      report.milliseconds["flip"] += ms_since(t);
-      t = Clock::now();
-      tangential_smoothing();
-      report.milliseconds["smooth"] += ms_since(t);
-      if (cycle == 0 && options_.cycles > 1) {
-        t = Clock::now();
-        reorder_spatially();
-        report.milliseconds["reorder"] += ms_since(t);
+      timed("split", [&] { report.splits += split_long_edges(); });
+      timed("collapse", [&] { report.collapses += collapse_short_edges(); });
+      timed("flip", [&] { report.flips += equalize_valences(); });
+      timed("smooth", [&] { tangential_smoothing(); });
+      if (cycle == 0 && options_.cycles > 1) timed("reorder", [&] { reorder_spatially(); });
+    }
+    timed("reorder", [&] { reorder_spatially(); });
+    timed("repair", [&] { report.repairs += repair_bad_triangles(options_.repair_angle_deg); });
+    timed("report", [&] {
+      report.after_cycles = mesh_quality(mesh_);
+      report.symmetry_defect_cycles = laplacian_symmetry_defect(mesh_);
+    });
+
+    timed("equalize", [&] {
+      for (int it = 0; it < options_.equalize_iterations; ++it) {
+        progress("equalize", it, options_.equalize_iterations);
+        equalize_areas();
       }
-    }
-    t = Clock::now();
-    reorder_spatially();
-    report.milliseconds["reorder"] += ms_since(t);
+      if (options_.equalize_iterations > 0)
+        report.repairs += repair_bad_triangles(options_.repair_angle_deg);
+    });
+    timed("report", [&] {
+      report.after_equalization = mesh_quality(mesh_);
+      report.symmetry_defect_output = laplacian_symmetry_defect(mesh_);
+      measure_distances(report);
+    });
 
-    t = Clock::now();
-    report.repairs += repair_bad_triangles(options_.repair_angle_deg);
-    report.milliseconds["repair"] += ms_since(t);
-
-    t = Clock::now();
-    report.after_cycles = mesh_quality(mesh_);
-    report.symmetry_defect_cycles = laplacian_symmetry_defect(mesh_);
-    report.milliseconds["report"] += ms_since(t);
-
-    t = Clock::now();
-    for (int it = 0; it < options_.equalize_iterations; ++it) {
-      progress("equalize", it, options_.equalize_iterations);
-      equalize_areas();
-    }
-    if (options_.equalize_iterations > 0)
-      report.repairs += repair_bad_triangles(options_.repair_angle_deg);
-    report.milliseconds["equalize"] += ms_since(t);
-
-    t = Clock::now();
-    report.after_equalization = mesh_quality(mesh_);
-    report.symmetry_defect_output = laplacian_symmetry_defect(mesh_);
-    report.milliseconds["report"] += ms_since(t);
-
-    t = Clock::now();
-    measure_distances(report);
-    report.milliseconds["report"] += ms_since(t);
-
-    t = Clock::now();
-    progress("correspondence", 0, 1);
-    result.output_on_input.resize(mesh_.n_vertices());
-    for (auto v : mesh_.vertices()) result.output_on_input[v.idx()] = loc(v);
-    result.input_on_output = locate_input_vertices();
-    report.milliseconds["correspondence"] += ms_since(t);
+    timed("correspondence", [&] {
+      progress("correspondence", 0, 1);
+      result.output_on_input.resize(mesh_.n_vertices());
+      for (auto v : mesh_.vertices()) result.output_on_input[v.idx()] = loc(v);
+      result.input_on_output = locate_input_vertices();
+    });
 
     mesh_.remove_property(loc_prop_);
     mesh_.remove_property(bloc_prop_);
