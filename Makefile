@@ -25,8 +25,10 @@ build: deps
 	  $(CMAKE_FLAGS)
 	cmake --build $(BUILD) -j$(JOBS)
 
+# For now: the quality report of the bundled scan, then its area-equalizing remesh (paper §4).
 demo: build
 	$(BUILD)/bin/remora info $(DEMO_MESH)
+	$(BUILD)/bin/remora remesh $(DEMO_MESH) -o $(BUILD)/demo_remeshed.ply --report
 
 # Release build with warnings as errors, the formatting check, then the unit tests again under
 # AddressSanitizer + UndefinedBehaviorSanitizer.
