@@ -90,9 +90,9 @@ public:
       timed("collapse", [&] { report.collapses += collapse_short_edges(); });
       timed("flip", [&] { report.flips += equalize_valences(); });
       timed("smooth", [&] { tangential_smoothing(); });
-      if (cycle == 0 && options_.cycles > 1) timed("reorder", [&] { reorder_spatially(); });
+      if (cycle == 0 && options_.cycles > 1) timed("reorder", [&] { compact(); });
     }
-    timed("reorder", [&] { reorder_spatially(); });
+    timed("reorder", [&] { compact(); });
     timed("repair", [&] { report.repairs += repair_bad_triangles(options_.repair_angle_deg); });
     timed("report", [&] {
       report.after_cycles = mesh_quality(mesh_);
@@ -253,6 +253,17 @@ private:
     };
     summarize(vd, report.vertex_distance_mean, report.vertex_distance_max);
     summarize(fd, report.centroid_distance_mean, report.centroid_distance_max);
+  }
+
+  // Removes deleted elements; on large meshes also renumbers them spatially. Below ~30k faces
+  // the whole mesh stays in cache and renumbering only costs (measured: fandisk and fertility
+  // 10-15 % slower with it, bunny and lucy 9-12 % faster).
+  void compact() {
+    if (mesh_.n_faces() > 32768)
+      reorder_spatially();
+    else
+      mesh_.garbage_collection();
+    live_faces_ = mesh_.n_faces();
   }
 
   // Compacts the mesh and renumbers its vertices along a Z-order (Morton) curve of their
