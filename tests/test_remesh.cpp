@@ -284,6 +284,7 @@ TEST_P(RemeshData, MeetsThePapersAreaFigures) {
   EXPECT_GT(variance_ratio, 5.0);
   EXPECT_LT(rep.symmetry_defect_output, 0.06);
   EXPECT_GT(rep.after_equalization.angles.min_deg, 25.0);
+  EXPECT_LT(rep.after_equalization.angles.mean_abs_deviation_from_60_deg, 7.0);
   EXPECT_GT(fraction_in_band(r.mesh, rep.target_length), 0.95);
   for (auto f : r.mesh.faces()) {
     // No flipped face: the output normal agrees with the input's normal where at least one of

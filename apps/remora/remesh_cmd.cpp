@@ -96,7 +96,7 @@ void add_remesh_command(CLI::App& app) {
       app.add_subcommand("remesh", "Isotropic, area-equalizing remesh (paper section 4) of a mesh");
   struct Args {
     std::string in, out;
-    double length = 0, factor = 0.9, lambda = 0.5, smoothing = 1.0;
+    double length = 0, factor = 0.9, lambda = 0.5, smoothing = 1.5;
     std::string method = "newton";
     int cycles = 5, equalize = 10, threads = 0;
     bool no_project = false, report = false, json = false;
@@ -121,7 +121,7 @@ void add_remesh_command(CLI::App& app) {
                   "Area equalization: newton (default) or gravity (the paper's update)")
       ->check(CLI::IsMember({"newton", "gravity"}));
   cmd->add_option("--smoothing", a->smoothing,
-                  "newton: weight of the shape-keeping smoothing term (default 1)")
+                  "newton: weight of the shape-keeping smoothing term (default 1.5)")
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--threads", a->threads, "Worker threads (default: all)")
       ->check(CLI::NonNegativeNumber);

@@ -42,7 +42,7 @@ struct RemeshOptions {
   /// Damping factor λ of the area-equalizing update (both methods).
   double lambda = 0.5;
   /// Newton only: weight μ of the tangential-smoothing term, relative to the area term.
-  double equalize_smoothing = 1.0;
+  double equalize_smoothing = 1.5;
   /// Project moved vertices back onto the input surface (true), or only keep updates in the
   /// tangent plane (the paper's cheaper variant).
   bool project = true;
