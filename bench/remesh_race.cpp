@@ -262,6 +262,8 @@ void race(MeshRace& r, const Args& args) {
   eq_options.target_length = l; // what the default (length_factor 0.9) gives; explicit = same l
   eq_options.cycles = kCycles;
   eq_options.threads = args.threads;
+  // CGAL computes no quality figures either; both outputs are measured afterwards, untimed.
+  eq_options.compute_report = false;
   remora::RemeshOptions cycles_options = eq_options;
   cycles_options.equalize_iterations = 0;
 

@@ -243,6 +243,18 @@ TEST(Remesh, WithoutProjectionVerticesStayNearTheInput) {
   EXPECT_EQ(remesh(input, opt).report.vertex_distance_max, 0.0);
 }
 
+TEST(Remesh, WithoutTheReportTheMeshIsTheSame) {
+  const Mesh input = needle_grid();
+  RemeshOptions quiet;
+  quiet.compute_report = false;
+  const RemeshResult a = remesh(input), b = remesh(input, quiet);
+  ASSERT_EQ(a.mesh.n_vertices(), b.mesh.n_vertices());
+  for (auto v : a.mesh.vertices()) EXPECT_EQ(a.mesh.point(v), b.mesh.point(v));
+  EXPECT_EQ(b.report.after_equalization.faces, 0u); // not computed
+  EXPECT_EQ(b.report.splits, a.report.splits);
+  EXPECT_GT(a.report.after_equalization.faces, 0u);
+}
+
 TEST(Remesh, RejectsBadOptions) {
   const Mesh input = make_icosphere(1);
   RemeshOptions opt;

@@ -142,6 +142,7 @@ void add_remesh_command(CLI::App& app) {
     options.equalize_smoothing = a->smoothing;
     options.threads = a->threads;
     options.project = !a->no_project;
+    options.compute_report = a->report || a->json; // the figures cost 10-16 % of the time
     ProgressLine progress;
     options.progress = [&](std::string_view phase, int step, int steps) {
       progress.update(phase, step, steps);

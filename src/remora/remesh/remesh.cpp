@@ -78,10 +78,12 @@ public:
     hi_ = 4.0 / 3.0 * length_;
     hi2_ = hi_ * hi_;
 
-    timed("report", [&] {
-      report.input = mesh_quality(input_);
-      report.symmetry_defect_input = laplacian_symmetry_defect(input_);
-    });
+    const bool figures = options_.compute_report;
+    if (figures)
+      timed("report", [&] {
+        report.input = mesh_quality(input_);
+        report.symmetry_defect_input = laplacian_symmetry_defect(input_);
+      });
 
     init_locations();
     for (int cycle = 0; cycle < options_.cycles; ++cycle) {
@@ -94,10 +96,11 @@ public:
     }
     timed("reorder", [&] { compact(); });
     timed("repair", [&] { report.repairs += repair_bad_triangles(options_.repair_angle_deg); });
-    timed("report", [&] {
-      report.after_cycles = mesh_quality(mesh_);
-      report.symmetry_defect_cycles = laplacian_symmetry_defect(mesh_);
-    });
+    if (figures)
+      timed("report", [&] {
+        report.after_cycles = mesh_quality(mesh_);
+        report.symmetry_defect_cycles = laplacian_symmetry_defect(mesh_);
+      });
 
     timed("equalize", [&] {
       for (int it = 0; it < options_.equalize_iterations; ++it) {
@@ -107,11 +110,12 @@ public:
       if (options_.equalize_iterations > 0)
         report.repairs += repair_bad_triangles(options_.repair_angle_deg);
     });
-    timed("report", [&] {
-      report.after_equalization = mesh_quality(mesh_);
-      report.symmetry_defect_output = laplacian_symmetry_defect(mesh_);
-      measure_distances(report);
-    });
+    if (figures)
+      timed("report", [&] {
+        report.after_equalization = mesh_quality(mesh_);
+        report.symmetry_defect_output = laplacian_symmetry_defect(mesh_);
+        measure_distances(report);
+      });
 
     timed("correspondence", [&] {
       progress("correspondence", 0, 1);
