@@ -9,6 +9,7 @@
 #include "remora/mesh/primitives.h"
 #include "remora/mesh/surface_point.h"
 #include "remora/mesh/topology.h"
+#include "support.h"
 
 namespace remora {
 namespace {
@@ -30,10 +31,7 @@ TEST(BuildMesh, RebuildsClosedAndOpenMeshesExactly) {
     Triangles tris;
     triangles_of(original, points, tris);
     const Mesh m = build_mesh(points, tris);
-    std::ostringstream problems;
-    EXPECT_TRUE(OpenMesh::Utils::MeshCheckerT<Mesh>(m).check(
-        OpenMesh::Utils::MeshCheckerT<Mesh>::CHECK_ALL, problems))
-        << problems.str();
+    testing::expect_valid_halfedge_mesh(m);
     EXPECT_EQ(m.n_vertices(), original.n_vertices());
     EXPECT_EQ(m.n_faces(), original.n_faces());
     EXPECT_EQ(m.n_edges(), original.n_edges());

@@ -9,9 +9,13 @@
 
 #include "remora/mesh/io.h"
 #include "remora/mesh/topology.h"
+#include "support.h"
 
 namespace remora {
 namespace {
+
+using testing::expect_valid_halfedge_mesh;
+using testing::signed_volume;
 
 namespace fs = std::filesystem;
 
@@ -52,14 +56,6 @@ void PrintTo(const Expected& e, std::ostream* os) {
   *os << e.path;
 }
 
-void expect_valid_halfedge_mesh(const Mesh& mesh) {
-  std::ostringstream problems;
-  EXPECT_TRUE(OpenMesh::Utils::MeshCheckerT<Mesh>(mesh).check(
-      OpenMesh::Utils::MeshCheckerT<Mesh>::CHECK_ALL, problems))
-      << problems.str();
-  for (auto v : mesh.vertices()) ASSERT_TRUE(mesh.is_manifold(v)) << "vertex " << v.idx();
-}
-
 class DataCatalogue : public ::testing::TestWithParam<Expected> {};
 
 TEST_P(DataCatalogue, EveryFaceIsLoadedOrDroppedWithAReason) {
@@ -95,18 +91,6 @@ INSTANTIATE_TEST_SUITE_P(SharedData, DataCatalogue, ::testing::ValuesIn(kCatalog
                              if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
                            return label;
                          });
-
-double signed_volume(const Mesh& m) {
-  double v = 0;
-  for (auto f : m.faces()) {
-    auto h = m.halfedge_handle(f);
-    const Vec3& a = m.point(m.from_vertex_handle(h));
-    const Vec3& b = m.point(m.to_vertex_handle(h));
-    const Vec3& c = m.point(m.to_vertex_handle(m.next_halfedge_handle(h)));
-    v += OpenMesh::dot(a, OpenMesh::cross(b, c)) / 6.0;
-  }
-  return v;
-}
 
 TEST(DataAcceptance, ConrodBecomesOneClosedOutwardComponent) {
   const std::string path = shared_path("cad/conrod.stl");

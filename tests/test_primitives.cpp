@@ -15,9 +15,12 @@
 #include "remora/geometry/measures.h"
 #include "remora/mesh/primitives.h"
 #include "remora/mesh/topology.h"
+#include "support.h"
 
 namespace remora {
 namespace {
+
+using testing::signed_volume;
 
 constexpr double kPi = std::numbers::pi;
 
@@ -40,14 +43,6 @@ Vec3 centroid(const Mesh& mesh, FaceHandle f) {
 }
 
 /// Signed volume enclosed by a closed, outward-oriented mesh (divergence theorem).
-double signed_volume(const Mesh& mesh) {
-  double volume = 0.0;
-  for (const FaceHandle f : mesh.faces()) {
-    const std::array<Vec3, 3> p = corners(mesh, f);
-    volume += (p[0] | (p[1] % p[2])) / 6.0;
-  }
-  return volume;
-}
 
 void expect_flat_and_up(const Mesh& mesh) {
   for (const VertexHandle v : mesh.vertices()) EXPECT_EQ(mesh.point(v)[2], 0.0);

@@ -10,9 +10,13 @@
 
 #include "remora/common/error.h"
 #include "remora/mesh/repair.h"
+#include "support.h"
 
 namespace remora {
 namespace {
+
+using testing::expect_valid_halfedge_mesh;
+using testing::signed_volume;
 
 PolygonSoup soup_of(std::vector<Vec3> points,
                     const std::vector<std::vector<std::uint32_t>>& polys) {
@@ -32,26 +36,8 @@ void expect_accounting(const RepairResult& r) {
   EXPECT_EQ(r.mesh.n_faces(), rep.faces_loaded);
   EXPECT_EQ(r.mesh.n_vertices(), rep.vertices_loaded);
   EXPECT_EQ(r.source_vertex.size(), r.mesh.n_vertices());
-  std::ostringstream problems;
-  EXPECT_TRUE(OpenMesh::Utils::MeshCheckerT<Mesh>(r.mesh).check(
-      OpenMesh::Utils::MeshCheckerT<Mesh>::CHECK_ALL, problems))
-      << problems.str();
-  for (auto v : r.mesh.vertices()) {
-    EXPECT_TRUE(r.mesh.is_manifold(v)) << "vertex " << v.idx();
-    EXPECT_FALSE(r.mesh.is_isolated(v)) << "vertex " << v.idx();
-  }
-}
-
-double signed_volume(const Mesh& m) {
-  double v = 0;
-  for (auto f : m.faces()) {
-    auto h = m.halfedge_handle(f);
-    const Vec3& a = m.point(m.from_vertex_handle(h));
-    const Vec3& b = m.point(m.to_vertex_handle(h));
-    const Vec3& c = m.point(m.to_vertex_handle(m.next_halfedge_handle(h)));
-    v += OpenMesh::dot(a, OpenMesh::cross(b, c)) / 6.0;
-  }
-  return v;
+  expect_valid_halfedge_mesh(r.mesh);
+  for (auto v : r.mesh.vertices()) EXPECT_FALSE(r.mesh.is_isolated(v)) << "vertex " << v.idx();
 }
 
 bool is_closed(const Mesh& m) {
