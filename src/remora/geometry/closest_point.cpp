@@ -1,6 +1,8 @@
 #include "remora/geometry/closest_point.h"
 
 #include <algorithm>
+#include <array>
+#include <limits>
 
 namespace remora {
 namespace {
@@ -21,13 +23,23 @@ TriangleClosest at_corner(const Vec3& p, const Vec3& corner, int index) {
   return result;
 }
 
-TriangleClosest on_edges(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
-  const SegmentClosest ab = closest_point_on_segment(p, a, b);
-  const SegmentClosest bc = closest_point_on_segment(p, b, c);
-  const SegmentClosest ca = closest_point_on_segment(p, c, a);
-  TriangleClosest result{ab.point, {1.0 - ab.t, ab.t, 0.0}, ab.distance2};
-  if (bc.distance2 < result.distance2) result = {bc.point, {0.0, 1.0 - bc.t, bc.t}, bc.distance2};
-  if (ca.distance2 < result.distance2) result = {ca.point, {ca.t, 0.0, 1.0 - ca.t}, ca.distance2};
+// The closest of the edges ab, bc, ca that `use` selects (by default all three).
+TriangleClosest on_edges(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c,
+                         std::array<bool, 3> use = {true, true, true}) {
+  TriangleClosest result;
+  result.distance2 = std::numeric_limits<double>::infinity();
+  if (use[0]) {
+    const SegmentClosest ab = closest_point_on_segment(p, a, b);
+    result = {ab.point, {1.0 - ab.t, ab.t, 0.0}, ab.distance2};
+  }
+  if (use[1]) {
+    const SegmentClosest bc = closest_point_on_segment(p, b, c);
+    if (bc.distance2 < result.distance2) result = {bc.point, {0.0, 1.0 - bc.t, bc.t}, bc.distance2};
+  }
+  if (use[2]) {
+    const SegmentClosest ca = closest_point_on_segment(p, c, a);
+    if (ca.distance2 < result.distance2) result = {ca.point, {ca.t, 0.0, 1.0 - ca.t}, ca.distance2};
+  }
   return result;
 }
 
@@ -91,6 +103,12 @@ TriangleClosest closest_point_on_triangle(const Vec3& p, const Vec3& a, const Ve
     const TriangleClosest edges = on_edges(p, a, b, c);
     return edges.distance2 < face.distance2 ? edges : face;
   }
+  // Outside: the closest point of a convex polygon lies on an edge whose line separates p from
+  // it, i.e. one with a negative sub-area (u is opposite bc, v opposite ca, w opposite ab). Only
+  // a well-shaped triangle's signs are trusted for this.
+  const bool any = w < 0.0 || u < 0.0 || v < 0.0; // false only for a non-finite p
+  if (any && twice_area >= kThin * longest)
+    return on_edges(p, a, b, c, {w < 0.0, u < 0.0, v < 0.0});
   return on_edges(p, a, b, c);
 }
 

@@ -207,24 +207,32 @@ private:
       loc(v) = bp.point;
       bloc(v) = bp.halfedge;
     } else {
-      // Most moves stay close above the face the vertex was on, or cross one of its edges:
-      // when the closest point on that face (or on the face across the edge it left by) is
-      // strictly inside it and within l/100, only a sheet of the surface passing closer than
-      // that could be closer, and the full walk is skipped.
-      const FaceHandle f = loc(near).face;
+      // Most moves stay close above the face the vertex was on, or cross a few faces: a directed
+      // walk follows the closest point across the edge or around the corner it leaves by, only
+      // downhill, until it is strictly inside a face and within l/100 (then only a sheet of the
+      // surface passing closer than that could be closer). Otherwise the full walk runs from the
+      // start: a walk from wherever a wrong turn led (across the fold of a thin plate, say) can
+      // end in a local minimum far from p.
+      const FaceHandle start = loc(near).face;
+      FaceHandle f = start;
       SurfacePoint quick;
-      if (close_inside(p, f, quick)) {
-        loc(v) = quick;
-      } else {
-        const HalfedgeHandle exit = exit_halfedge(f, quick);
-        const FaceHandle g = exit.is_valid()
-                                 ? input_.face_handle(input_.opposite_halfedge_handle(exit))
-                                 : FaceHandle();
-        if (g.is_valid() && close_inside(p, g, quick))
-          loc(v) = quick;
-        else
-          loc(v) = walk_to_closest(input_, p, f);
+      double d2 = 0;
+      bool found = close_inside(p, f, quick, d2);
+      for (int step = 0; step < 8 && !found; ++step) {
+        const FaceHandle g = next_face_towards(p, f, quick);
+        if (!g.is_valid()) break;
+        SurfacePoint there;
+        double there_d2 = 0;
+        found = close_inside(p, g, there, there_d2);
+        if (!(there_d2 < d2)) {
+          found = false;
+          break;
+        }
+        f = g;
+        quick = there;
+        d2 = there_d2;
       }
+      loc(v) = found ? quick : walk_to_closest(input_, p, start);
     }
     return options_.project ? evaluate(input_, loc(v)) : p;
   }
@@ -340,31 +348,53 @@ private:
 
   // Is the closest point of face f to p strictly inside f and within l/100 of p? `out` gets it
   // either way.
-  bool close_inside(const Vec3& p, FaceHandle f, SurfacePoint& out) const {
+  bool close_inside(const Vec3& p, FaceHandle f, SurfacePoint& out, double& distance2) const {
     const auto fv = face_vertices(input_, f);
     const TriangleClosest c =
         closest_point_on_triangle(p, input_.point(fv[0]), input_.point(fv[1]), input_.point(fv[2]));
     out = SurfacePoint{f, c.bary};
+    distance2 = c.distance2;
     constexpr double inside = 1e-6;
     return c.bary[0] > inside && c.bary[1] > inside && c.bary[2] > inside &&
            c.distance2 <= 1e-4 * length_ * length_;
   }
 
-  // The halfedge of f across which its closest point `sp` left it: the edge opposite the one
-  // corner whose weight vanished (invalid when two vanished, i.e. at a corner).
-  HalfedgeHandle exit_halfedge(FaceHandle f, const SurfacePoint& sp) const {
-    int zero = -1, zeros = 0;
-    for (int k = 0; k < 3; ++k)
+  // Where the closest point `sp` of p on face f left it: across an edge (one weight vanished),
+  // the face on the other side; at a corner (two vanished), the face around that corner closest
+  // to p. Invalid at the input boundary or when no face of the fan is closer.
+  FaceHandle next_face_towards(const Vec3& p, FaceHandle f, const SurfacePoint& sp) const {
+    int zero = -1, zeros = 0, kept = -1;
+    for (int k = 0; k < 3; ++k) {
       if (sp.bary[k] <= 0.0) {
         zero = k;
         ++zeros;
+      } else {
+        kept = k;
       }
-    if (zeros != 1) return HalfedgeHandle();
-    // halfedge_handle(f) runs v0 -> v1, opposite v2; then v1 -> v2 (opposite v0), v2 -> v0.
-    HalfedgeHandle h = input_.halfedge_handle(f);
-    if (zero == 0) h = input_.next_halfedge_handle(h);
-    if (zero == 1) h = input_.prev_halfedge_handle(h);
-    return input_.is_boundary(input_.opposite_halfedge_handle(h)) ? HalfedgeHandle() : h;
+    }
+    if (zeros == 1) {
+      // halfedge_handle(f) runs v0 -> v1, opposite v2; then v1 -> v2 (opposite v0), v2 -> v0.
+      HalfedgeHandle h = input_.halfedge_handle(f);
+      if (zero == 0) h = input_.next_halfedge_handle(h);
+      if (zero == 1) h = input_.prev_halfedge_handle(h);
+      return input_.face_handle(input_.opposite_halfedge_handle(h));
+    }
+    if (zeros != 2) return FaceHandle();
+    const VertexHandle corner = face_vertices(input_, f)[static_cast<std::size_t>(kept)];
+    double best = (p - evaluate(input_, sp)).sqrnorm();
+    FaceHandle best_face;
+    for (auto h : input_.voh_range(corner)) {
+      const FaceHandle g = input_.face_handle(h);
+      if (!g.is_valid() || g == f) continue;
+      const Vec3 q = input_.point(input_.to_vertex_handle(h));
+      const Vec3 r = input_.point(input_.to_vertex_handle(input_.next_halfedge_handle(h)));
+      const double d2 = closest_point_on_triangle(p, input_.point(corner), q, r).distance2;
+      if (d2 < best) {
+        best = d2;
+        best_face = g;
+      }
+    }
+    return best_face;
   }
 
   // Each input vertex's closest point on the output, found by a local walk from the face the
@@ -556,9 +586,16 @@ private:
     return count;
   }
 
-  int target_valence(VertexHandle v) const { return mesh_.is_boundary(v) ? 4 : 6; }
-
+  // One pass of valence-improving flips over all edges. Valences and targets (6 inside, 4 on
+  // the boundary) are cached per vertex and updated by each flip.
   std::size_t equalize_valences() {
+    const std::size_t nv = mesh_.n_vertices();
+    std::vector<int> excess(nv, 0); // valence minus target valence
+    parallel_for(nv, options_.threads, [&](std::size_t i) {
+      const VertexHandle v(static_cast<int>(i));
+      if (mesh_.status(v).deleted()) return;
+      excess[i] = static_cast<int>(mesh_.valence(v)) - (mesh_.is_boundary(v) ? 4 : 6);
+    });
     std::size_t count = 0;
     const std::size_t n = mesh_.n_edges();
     for (std::size_t i = 0; i < n; ++i) {
@@ -569,16 +606,20 @@ private:
       const VertexHandle c = mesh_.to_vertex_handle(mesh_.next_halfedge_handle(h0));
       const VertexHandle d = mesh_.to_vertex_handle(mesh_.next_halfedge_handle(h1));
       if (c == d) continue;
-      const int va = static_cast<int>(mesh_.valence(a)), vb = static_cast<int>(mesh_.valence(b));
-      const int vc = static_cast<int>(mesh_.valence(c)), vd = static_cast<int>(mesh_.valence(d));
-      const int ta = target_valence(a), tb = target_valence(b), tc = target_valence(c),
-                td = target_valence(d);
+      int& xa = excess[static_cast<std::size_t>(a.idx())];
+      int& xb = excess[static_cast<std::size_t>(b.idx())];
+      int& xc = excess[static_cast<std::size_t>(c.idx())];
+      int& xd = excess[static_cast<std::size_t>(d.idx())];
       auto sq = [](int x) { return x * x; };
-      const int before = sq(va - ta) + sq(vb - tb) + sq(vc - tc) + sq(vd - td);
-      const int after = sq(va - 1 - ta) + sq(vb - 1 - tb) + sq(vc + 1 - tc) + sq(vd + 1 - td);
+      const int before = sq(xa) + sq(xb) + sq(xc) + sq(xd);
+      const int after = sq(xa - 1) + sq(xb - 1) + sq(xc + 1) + sq(xd + 1);
       if (after >= before || !mesh_.is_flip_ok(e)) continue;
       if (!flip_keeps_orientation(a, b, c, d)) continue;
       mesh_.flip(e);
+      --xa;
+      --xb;
+      ++xc;
+      ++xd;
       ++count;
     }
     return count;
@@ -703,12 +744,29 @@ private:
   // the gravity update, whose fixed point is not an equal-area mesh, r = 0 is (up to μ) this
   // iteration's fixed point. Jacobi-style (all vertices at once), hence the damping λ.
   void equalize_areas_newton() {
-    const Eigen::VectorXd area = vertex_areas_mixed(mesh_);
+    // The mixed-area parts of every face at the current positions (face_vertices order), and the
+    // vertex areas they sum to.
+    const std::size_t nf = mesh_.n_faces();
+    std::vector<std::array<double, 3>> face_parts(nf);
+    parallel_for(nf, options_.threads, [&](std::size_t i) {
+      const FaceHandle f(static_cast<int>(i));
+      if (mesh_.status(f).deleted()) return;
+      const auto fv = face_vertices(mesh_, f);
+      face_parts[i] =
+          triangle_mixed_areas(mesh_.point(fv[0]), mesh_.point(fv[1]), mesh_.point(fv[2]));
+    });
+    std::vector<double> area(mesh_.n_vertices(), 0.0);
+    for (std::size_t i = 0; i < nf; ++i) {
+      const FaceHandle f(static_cast<int>(i));
+      if (mesh_.status(f).deleted()) continue;
+      const auto fv = face_vertices(mesh_, f);
+      for (int c = 0; c < 3; ++c) area[static_cast<std::size_t>(fv[c].idx())] += face_parts[i][c];
+    }
     double sum = 0;
     std::size_t count = 0;
     for (auto v : mesh_.vertices())
       if (kind(v) == Kind::Interior && !mesh_.is_isolated(v)) {
-        sum += area[v.idx()];
+        sum += area[static_cast<std::size_t>(v.idx())];
         ++count;
       }
     if (count == 0) return;
@@ -717,54 +775,71 @@ private:
     move_vertices([&](VertexHandle v, Vec3& goal) {
       if (kind(v) != Kind::Interior) return false;
       const Vec3 p = mesh_.point(v);
-      const Vec3 n = vertex_normal(v);
-      if (n.sqrnorm() == 0) return false;
-      // The one-ring in order: ring[k] = to(h_k); face k = (v, ring[k], ring[k+1]).
-      VertexHandle ring[64];
-      bool face_ok[64];
+      // The one-ring: ring[j] = to(h_j); face j = (v, ring[j], ring[third[j]]) when it exists.
+      constexpr int kMax = 64;
+      VertexHandle ring[kMax];
+      FaceHandle face[kMax];
+      int third[kMax];
       int k = 0;
-      Vec3 centroid(0, 0, 0);
       for (auto h : mesh_.voh_range(v)) {
-        if (k == 64) return false;
+        if (k == kMax) return false;
         ring[k] = mesh_.to_vertex_handle(h);
-        face_ok[k] = !mesh_.is_boundary(h);
-        centroid += mesh_.point(ring[k]);
+        face[k] = mesh_.face_handle(h);
         ++k;
       }
       if (k < 3) return false;
-      centroid /= k;
       // Next to the boundary (which does not move here) the area term would squeeze the
       // boundary triangles: keep to plain tangential smoothing there.
       bool near_boundary = false;
       for (int j = 0; j < k; ++j) near_boundary |= kind(ring[j]) != Kind::Interior;
+      // The circulator turns one way: the third corner of face j is ring[j + 1] or ring[j - 1].
+      const HalfedgeHandle h0 = *mesh_.cvoh_begin(v);
+      const VertexHandle c0 = mesh_.to_vertex_handle(mesh_.next_halfedge_handle(h0));
+      const int turn = c0 == ring[1] ? 1 : k - 1;
+      Vec3 centroid(0, 0, 0), normal(0, 0, 0);
+      for (int j = 0; j < k; ++j) {
+        third[j] = (j + turn) % k;
+        centroid += mesh_.point(ring[j]);
+        if (face[j].is_valid())
+          normal += OpenMesh::cross(mesh_.point(ring[j]) - p, mesh_.point(ring[third[j]]) - p);
+      }
+      centroid /= k;
+      const double normal_length = normal.norm();
+      if (!(normal_length > 0)) return false;
+      const Vec3 n = normal / normal_length;
       if (near_boundary) {
         Vec3 u = centroid - p;
         u -= n * OpenMesh::dot(n, u);
         goal = p + u * options_.lambda;
         return true;
       }
-      // Mixed-area parts of v and each ring vertex from the faces around v, for v at q.
-      auto parts = [&](const Vec3& q, double* self, double* nb) {
-        *self = 0;
-        for (int j = 0; j < k; ++j) nb[j] = 0;
+      // Mixed-area parts of v (index k) and of each ring vertex from the faces around v: at the
+      // current position from face_parts, for v moved to q recomputed.
+      double base[kMax + 1] = {}, moved[kMax + 1], d1[kMax + 1], d2[kMax + 1];
+      for (int j = 0; j < k; ++j) {
+        if (!face[j].is_valid()) continue;
+        const auto fv = face_vertices(mesh_, face[j]);
+        const auto& part = face_parts[static_cast<std::size_t>(face[j].idx())];
+        for (int c = 0; c < 3; ++c)
+          base[fv[c] == v ? k : fv[c] == ring[j] ? j : third[j]] += part[c];
+      }
+      auto parts = [&](const Vec3& q, double* out) {
+        for (int j = 0; j <= k; ++j) out[j] = 0;
         for (int j = 0; j < k; ++j) {
-          if (!face_ok[j]) continue;
-          const int j1 = (j + 1) % k;
-          const auto m = triangle_mixed_areas(q, mesh_.point(ring[j]), mesh_.point(ring[j1]));
-          *self += m[0];
-          nb[j] += m[1];
-          nb[j1] += m[2];
+          if (!face[j].is_valid()) continue;
+          const auto m = triangle_mixed_areas(q, mesh_.point(ring[j]), mesh_.point(ring[third[j]]));
+          out[k] += m[0];
+          out[j] += m[1];
+          out[third[j]] += m[2];
         }
       };
       Vec3 t1 = OpenMesh::cross(n, std::abs(n[0]) < 0.9 ? Vec3(1, 0, 0) : Vec3(0, 1, 0));
       t1.normalize();
       const Vec3 t2 = OpenMesh::cross(n, t1);
-      double base[65], moved[65], d1[65], d2[65];
-      parts(p, &base[k], base);
       for (int axis = 0; axis < 2; ++axis) {
         const Vec3 t = axis == 0 ? t1 : t2;
         double* d = axis == 0 ? d1 : d2;
-        parts(p + t * eps, &moved[k], moved);
+        parts(p + t * eps, moved);
         for (int j = 0; j <= k; ++j) d[j] = (moved[j] - base[j]) / eps;
       }
       // Residuals: the ring's interior vertices and v itself (index k).
@@ -775,7 +850,7 @@ private:
         if (kind(w) != Kind::Interior) continue;
         const Eigen::Vector2d row(d1[j], d2[j]);
         jtj += row * row.transpose();
-        jtr += row * (area[w.idx()] - target);
+        jtr += row * (area[static_cast<std::size_t>(w.idx())] - target);
       }
       const Vec3 off = p - centroid;
       const double mu = options_.equalize_smoothing * 0.5 * jtj.trace();
