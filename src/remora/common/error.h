@@ -22,6 +22,13 @@ public:
   using Error::Error;
 };
 
+/// A numerical method failed: a factorization met a non-positive pivot, an iteration did not
+/// converge. what() names the method and the figure (pivot, iterations, residual).
+class NumericalError : public Error {
+public:
+  using Error::Error;
+};
+
 /// A file could not be read or written, or its content is malformed. what() reads
 /// "<path>: line <n>: <problem>" or "<path>: byte <offset>: <problem>" when the place is known.
 class IoError : public Error {

@@ -1,0 +1,88 @@
+// The k-harmonic systems of Botsch & Kobbelt 2004, §3 (Eq. 1-3) and §5: Δ^k p = 0 at the free
+// vertices of a region, with the handle and fixed vertices as boundary values.
+//
+// With W the cotan weights and A the mixed areas (geometry/laplacian.h), Δ = A⁻¹W. The system is
+// the rows of the free vertices F of (−1)^k S Δ^k, split into the free columns (the matrix) and
+// the constrained columns C (moved to the right-hand side):
+//   matrix · x_F = −coupling · x_C.
+// Three weightings S, Δ (AreaWeights):
+//   Mixed          S = I, each vertex's own area: unsymmetric on an arbitrary mesh (paper §5, (a));
+//   Mean           every area replaced by the mean Ā, S = Ā^k: the rows of (−W)^k, symmetric
+//                  positive definite (the paper's choice after the area-equalizing remesh, (b));
+//   MixedSymmetric S = A_F, the exact areas made symmetric by scaling each row by its own area:
+//                  rows of −W (−A⁻¹W)^(k−1), i.e. −W, W A⁻¹ W, −W A⁻¹ W A⁻¹ W — symmetric and
+//                  positive definite as well, with no area approximation (docs/solvers.md).
+// Positive definiteness: (−W) is positive semi-definite with the constants of each connected
+// component as its kernel, so every symmetric form above is positive definite on the free
+// vertices exactly when every mesh component that has a free vertex also has a constrained one;
+// assemble_kharmonic() checks that and throws otherwise.
+//
+// The mesh's own boundary: a free vertex on it keeps its row of W, which has no term across the
+// boundary. For k = 1 that is the natural (zero normal derivative) boundary condition of the
+// Dirichlet energy xᵀ(−W)x; for k = 2 the rows are those of the minimizer of the thin-plate
+// energy xᵀ W A⁻¹ W x over the free vertices, again with natural conditions at the boundary.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Dense>
+#include <Eigen/SparseCore>
+
+#include "remora/mesh/mesh.h"
+
+namespace remora {
+
+using SparseMatrix = Eigen::SparseMatrix<double>;
+
+/// What each vertex of a mesh does in an edit: free (the support, solved for), fixed, or part
+/// of handle j (j = 0, 1, ...). Constrained = fixed or handle.
+struct Region {
+  static constexpr int kFree = -1;
+  static constexpr int kFixed = -2;
+  std::vector<int> label; ///< one per vertex (by idx()): kFree, kFixed or a handle index >= 0
+
+  /// All vertices fixed.
+  static Region all_fixed(std::size_t n_vertices) { return {std::vector<int>(n_vertices, kFixed)}; }
+  /// 1 + the largest handle index (0 without handles).
+  int handle_count() const;
+  std::size_t free_count() const;
+};
+
+enum class AreaWeights { Mixed, Mean, MixedSymmetric };
+
+/// "mixed", "mean", "mixed-symmetric"; parse_area_weights() throws InvalidArgument otherwise.
+std::string to_string(AreaWeights weights);
+AreaWeights parse_area_weights(const std::string& name);
+
+struct KHarmonicOptions {
+  int k = 2; ///< 1 (membrane), 2 (thin plate), 3 (minimum variation of curvature)
+  AreaWeights areas = AreaWeights::Mean;
+};
+
+struct KHarmonicSystem {
+  SparseMatrix matrix;   ///< free × free
+  SparseMatrix coupling; ///< free × constrained
+  std::vector<int> free_vertices;        ///< row r of the system is vertex free_vertices[r]
+  std::vector<int> constrained_vertices; ///< column c of coupling is this vertex
+  std::vector<int> row_of;               ///< vertex -> row, or -1 when not free
+  bool symmetric = false;                ///< true for Mean and MixedSymmetric
+
+  /// −coupling · values, for values (constrained_vertices.size() × columns) in that order.
+  Eigen::MatrixXd rhs(const Eigen::MatrixXd& constrained_values) const;
+  /// The constrained vertices' rows of `positions` (n_vertices × columns).
+  Eigen::MatrixXd gather_constrained(const Eigen::MatrixXd& positions) const;
+};
+
+/// Assembles the system of the region on `mesh` (see the top of this file). Throws
+/// InvalidArgument when the label vector does not have one entry per vertex, a label is below
+/// kFixed, k is not 1, 2 or 3, nothing is free, a handle index in [0, handle_count()) has no
+/// vertex or touches no free vertex, or a mesh component has free vertices but no constrained
+/// one (the system would be singular). The message names the offending vertex or handle.
+KHarmonicSystem assemble_kharmonic(const Mesh& mesh, const Region& region,
+                                   const KHarmonicOptions& options = {});
+
+/// The vertex positions as an n_vertices × 3 matrix, and back.
+Eigen::MatrixXd positions_matrix(const Mesh& mesh);
+
+} // namespace remora

@@ -1,0 +1,440 @@
+#include "remora/linalg/solver.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <queue>
+
+#include <Eigen/IterativeLinearSolvers>
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseLU>
+#include <fmt/core.h>
+
+#ifdef REMORA_WITH_GPL_SOLVERS
+#include <Eigen/CholmodSupport>
+#include <Eigen/UmfPackSupport>
+#endif
+
+#include "remora/common/error.h"
+
+extern "C" {
+// LAPACK (OpenBLAS): Cholesky factorization and solve of a symmetric positive definite band matrix.
+void dpbtrf_(const char* uplo, const int* n, const int* kd, double* ab, const int* ldab, int* info);
+void dpbtrs_(const char* uplo, const int* n, const int* kd, const int* nrhs, const double* ab,
+             const int* ldab, double* b, const int* ldb, int* info);
+}
+
+namespace remora {
+
+namespace {
+
+using Sparse = Eigen::SparseMatrix<double>;
+
+void require_square(const Sparse& a, const std::string& who) {
+  if (a.rows() != a.cols() || a.rows() == 0)
+    throw InvalidArgument(who + ": the matrix must be square and non-empty (got " +
+                          std::to_string(a.rows()) + " x " + std::to_string(a.cols()) + ")");
+}
+
+void require_rhs(Eigen::Index n, const Eigen::MatrixXd& b, const std::string& who) {
+  if (b.rows() != n)
+    throw InvalidArgument(who + ": the right-hand side has " + std::to_string(b.rows()) +
+                          " rows for a system of dimension " + std::to_string(n));
+  if (!b.allFinite()) throw InvalidArgument(who + ": the right-hand side has a NaN or Inf entry");
+}
+
+void require_finite(const Sparse& a, const std::string& who) {
+  for (Eigen::Index k = 0; k < a.nonZeros(); ++k)
+    if (!std::isfinite(a.valuePtr()[k]))
+      throw InvalidArgument(who + ": the matrix has a NaN or Inf entry");
+}
+
+std::string not_spd(const std::string& who) {
+  return who +
+         ": the matrix is not positive definite (a support component without a fixed vertex, "
+         "degenerate geometry, or the unsymmetric system given to a Cholesky solver); use the "
+         "'mean' or 'mixed-symmetric' areas with Cholesky, or the 'lu' solver";
+}
+
+// ---- Eigen's simplicial Cholesky (ldlt, llt) ---------------------------------------------------
+
+template <class Base>
+struct Exposed : Base {
+  Eigen::Index factor_nonzeros() const { return this->m_matrix.nonZeros(); }
+};
+
+template <class Factorization>
+class SimplicialSolver final : public Solver {
+public:
+  explicit SimplicialSolver(std::string name) : name_(std::move(name)) {}
+  std::string name() const override { return name_; }
+  bool needs_spd() const override { return true; }
+  void analyze(const Sparse& a) override {
+    require_square(a, name_);
+    factorization_.analyzePattern(a);
+    n_ = a.rows();
+  }
+  void factorize(const Sparse& a) override {
+    require_finite(a, name_);
+    factorization_.factorize(a);
+    bool ok = factorization_.info() == Eigen::Success;
+    if constexpr (requires { factorization_.vectorD(); })
+      ok = ok && factorization_.vectorD().minCoeff() > 0;
+    if (!ok) throw NumericalError(not_spd(name_));
+    stats_.factor_nonzeros = static_cast<std::size_t>(factorization_.factor_nonzeros());
+    stats_.factor_bytes = stats_.factor_nonzeros * (sizeof(double) + sizeof(int)) +
+                          static_cast<std::size_t>(n_ + 1) * sizeof(int) * 3;
+  }
+  Eigen::MatrixXd solve(const Eigen::MatrixXd& b, const Eigen::MatrixXd*) override {
+    require_rhs(n_, b, name_);
+    return factorization_.solve(b);
+  }
+
+private:
+  std::string name_;
+  Exposed<Factorization> factorization_;
+  Eigen::Index n_ = 0;
+};
+
+// ---- CHOLMOD supernodal and UMFPACK (GPL) ---------------------------------------------------
+
+#ifdef REMORA_WITH_GPL_SOLVERS
+struct ExposedCholmod : Eigen::CholmodSupernodalLLT<Sparse, Eigen::Lower> {
+  const cholmod_factor* factor() const { return static_cast<const cholmod_factor*>(m_cholmodFactor); }
+};
+
+class CholmodSolver final : public Solver {
+public:
+  explicit CholmodSolver(bool metis) : metis_(metis) {
+    cholmod_common& c = llt_.cholmod();
+    c.nmethods = 1;
+    c.method[0].ordering = metis ? CHOLMOD_METIS : CHOLMOD_AMD;
+    c.postorder = 1;
+    c.print = 0; // failures are reported by our exception, not on stdout
+  }
+  std::string name() const override { return metis_ ? "cholmod (metis)" : "cholmod"; }
+  bool needs_spd() const override { return true; }
+  void analyze(const Sparse& a) override {
+    require_square(a, "cholmod");
+    llt_.analyzePattern(a);
+    n_ = a.rows();
+  }
+  void factorize(const Sparse& a) override {
+    require_finite(a, "cholmod");
+    llt_.factorize(a);
+    const cholmod_factor* l = llt_.factor();
+    if (llt_.info() != Eigen::Success || l == nullptr || l->minor < l->n)
+      throw NumericalError(not_spd("cholmod"));
+    stats_.factor_nonzeros = l->xsize;
+    stats_.factor_bytes = l->xsize * sizeof(double) + l->ssize * sizeof(SuiteSparse_long) +
+                          static_cast<std::size_t>(l->n) * 4 * sizeof(SuiteSparse_long);
+  }
+  Eigen::MatrixXd solve(const Eigen::MatrixXd& b, const Eigen::MatrixXd*) override {
+    require_rhs(n_, b, "cholmod");
+    return llt_.solve(b);
+  }
+
+private:
+  bool metis_;
+  ExposedCholmod llt_;
+  Eigen::Index n_ = 0;
+};
+#endif
+
+// ---- LU (unsymmetric) ----------------------------------------------------------------------
+
+template <class Factorization>
+class LuSolver final : public Solver {
+public:
+  std::string name() const override { return "lu"; }
+  bool needs_spd() const override { return false; }
+  void analyze(const Sparse& a) override {
+    require_square(a, "lu");
+    lu_.analyzePattern(a);
+    n_ = a.rows();
+  }
+  void factorize(const Sparse& a) override {
+    require_finite(a, "lu");
+    lu_.factorize(a);
+    if (lu_.info() != Eigen::Success)
+      throw NumericalError("lu: the matrix is singular (a support component without a fixed "
+                           "vertex, or degenerate geometry)");
+  }
+  Eigen::MatrixXd solve(const Eigen::MatrixXd& b, const Eigen::MatrixXd*) override {
+    require_rhs(n_, b, "lu");
+    return lu_.solve(b);
+  }
+
+private:
+  Factorization lu_;
+  Eigen::Index n_ = 0;
+};
+
+// ---- Iterative solvers -----------------------------------------------------------------------
+
+template <class Iteration>
+class IterativeSolver final : public Solver {
+public:
+  IterativeSolver(std::string name, bool spd, const SolverOptions& options)
+      : name_(std::move(name)), spd_(spd), options_(options) {}
+  std::string name() const override { return name_; }
+  bool needs_spd() const override { return spd_; }
+  void analyze(const Sparse& a) override {
+    require_square(a, name_);
+    iteration_.analyzePattern(a);
+    n_ = a.rows();
+  }
+  void factorize(const Sparse& a) override {
+    require_finite(a, name_);
+    iteration_.factorize(a);
+    if (iteration_.info() != Eigen::Success)
+      throw NumericalError(name_ + ": the preconditioner could not be built (a zero or negative "
+                                   "pivot); try the jacobi preconditioner or a direct solver");
+    iteration_.setTolerance(options_.tolerance);
+    iteration_.setMaxIterations(options_.max_iterations > 0 ? options_.max_iterations
+                                                            : static_cast<int>(10 * n_));
+  }
+  Eigen::MatrixXd solve(const Eigen::MatrixXd& b, const Eigen::MatrixXd* guess) override {
+    require_rhs(n_, b, name_);
+    if (guess && (guess->rows() != b.rows() || guess->cols() != b.cols()))
+      throw InvalidArgument(name_ + ": the start value has the wrong shape");
+    Eigen::MatrixXd x(b.rows(), b.cols());
+    stats_.iterations = 0;
+    stats_.residual = 0;
+    for (Eigen::Index c = 0; c < b.cols(); ++c) {
+      if (b.col(c).squaredNorm() == 0) {
+        x.col(c).setZero();
+        continue;
+      }
+      if (guess)
+        x.col(c) = iteration_.solveWithGuess(b.col(c), guess->col(c));
+      else
+        x.col(c) = iteration_.solve(b.col(c));
+      stats_.iterations = std::max(stats_.iterations, static_cast<int>(iteration_.iterations()));
+      stats_.residual = std::max(stats_.residual, iteration_.error());
+      if (iteration_.info() != Eigen::Success || !x.col(c).allFinite())
+        throw NumericalError(fmt::format(
+            "{}: no convergence after {} iterations (relative residual {:.3g}, tolerance {:.3g}); "
+            "raise the iteration limit, use a better preconditioner, or a direct solver",
+            name_, iteration_.iterations(), iteration_.error(), options_.tolerance));
+    }
+    return x;
+  }
+
+private:
+  std::string name_;
+  bool spd_;
+  SolverOptions options_;
+  Iteration iteration_;
+  Eigen::Index n_ = 0;
+};
+
+// ---- Banded Cholesky (paper §5.3) --------------------------------------------------------------
+
+class BandedSolver final : public Solver {
+public:
+  explicit BandedSolver(const SolverOptions& options) : options_(options) {}
+  std::string name() const override { return "banded"; }
+  bool needs_spd() const override { return true; }
+  void analyze(const Sparse& a) override {
+    require_square(a, "banded");
+    n_ = static_cast<int>(a.rows());
+    perm_ = reverse_cuthill_mckee(a);
+    inverse_.assign(perm_.size(), 0);
+    for (std::size_t i = 0; i < perm_.size(); ++i) inverse_[static_cast<std::size_t>(perm_[i])] = static_cast<int>(i);
+    kd_ = 0;
+    for (int j = 0; j < a.outerSize(); ++j)
+      for (Sparse::InnerIterator it(a, j); it; ++it)
+        kd_ = std::max(kd_, std::abs(inverse_[static_cast<std::size_t>(it.row())] -
+                                     inverse_[static_cast<std::size_t>(j)]));
+    stats_.bandwidth = kd_;
+    const std::size_t bytes = static_cast<std::size_t>(kd_ + 1) * static_cast<std::size_t>(n_) * sizeof(double);
+    if (bytes > options_.max_band_bytes)
+      throw NumericalError(fmt::format(
+          "banded: after reverse Cuthill-McKee the half-bandwidth is {} and the band would take "
+          "{:.1f} GB (limit {:.1f} GB); use cholmod or ldlt, whose fill is far smaller",
+          kd_, static_cast<double>(bytes) / 1e9, static_cast<double>(options_.max_band_bytes) / 1e9));
+  }
+  void factorize(const Sparse& a) override {
+    require_finite(a, "banded");
+    const int ld = kd_ + 1;
+    band_.assign(static_cast<std::size_t>(ld) * static_cast<std::size_t>(n_), 0.0);
+    // Lower band storage: A(i, j) with j <= i <= j + kd at band_[(i - j) + j * ld], permuted.
+    for (int j = 0; j < a.outerSize(); ++j)
+      for (Sparse::InnerIterator it(a, j); it; ++it) {
+        const int pi = inverse_[static_cast<std::size_t>(it.row())];
+        const int pj = inverse_[static_cast<std::size_t>(j)];
+        if (pi < pj) continue;
+        band_[static_cast<std::size_t>(pi - pj) + static_cast<std::size_t>(pj) * static_cast<std::size_t>(ld)] =
+            it.value();
+      }
+    int info = 0;
+    dpbtrf_("L", &n_, &kd_, band_.data(), &ld, &info);
+    if (info != 0) throw NumericalError(not_spd("banded"));
+    stats_.factor_nonzeros = band_.size();
+    stats_.factor_bytes = band_.size() * sizeof(double);
+  }
+  Eigen::MatrixXd solve(const Eigen::MatrixXd& b, const Eigen::MatrixXd*) override {
+    require_rhs(n_, b, "banded");
+    Eigen::MatrixXd x(b.rows(), b.cols());
+    for (int i = 0; i < n_; ++i) x.row(i) = b.row(perm_[static_cast<std::size_t>(i)]);
+    const int ld = kd_ + 1, nrhs = static_cast<int>(b.cols());
+    int info = 0;
+    dpbtrs_("L", &n_, &kd_, &nrhs, band_.data(), &ld, x.data(), &n_, &info);
+    if (info != 0) throw NumericalError("banded: dpbtrs failed with info " + std::to_string(info));
+    Eigen::MatrixXd out(b.rows(), b.cols());
+    for (int i = 0; i < n_; ++i) out.row(perm_[static_cast<std::size_t>(i)]) = x.row(i);
+    return out;
+  }
+
+private:
+  SolverOptions options_;
+  int n_ = 0, kd_ = 0;
+  std::vector<int> perm_, inverse_;
+  std::vector<double> band_;
+};
+
+} // namespace
+
+std::vector<int> reverse_cuthill_mckee(const Sparse& a) {
+  const auto n = static_cast<int>(a.rows());
+  // Symmetric adjacency (the pattern of A + Aᵀ without the diagonal).
+  std::vector<std::vector<int>> adjacent(static_cast<std::size_t>(n));
+  for (int j = 0; j < a.outerSize(); ++j)
+    for (Sparse::InnerIterator it(a, j); it; ++it) {
+      const int i = static_cast<int>(it.row());
+      if (i == j) continue;
+      adjacent[static_cast<std::size_t>(i)].push_back(j);
+      adjacent[static_cast<std::size_t>(j)].push_back(i);
+    }
+  std::vector<int> degree(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) {
+    auto& adj = adjacent[static_cast<std::size_t>(i)];
+    std::sort(adj.begin(), adj.end());
+    adj.erase(std::unique(adj.begin(), adj.end()), adj.end());
+    degree[static_cast<std::size_t>(i)] = static_cast<int>(adj.size());
+  }
+  std::vector<int> level(static_cast<std::size_t>(n), -1);
+  // Breadth-first levels from `root` over unnumbered vertices; returns the last level's vertices.
+  auto levels_from = [&](int root, std::vector<int>& touched) {
+    touched.clear();
+    touched.push_back(root);
+    level[static_cast<std::size_t>(root)] = 0;
+    for (std::size_t q = 0; q < touched.size(); ++q) {
+      const int u = touched[q];
+      for (int w : adjacent[static_cast<std::size_t>(u)])
+        if (level[static_cast<std::size_t>(w)] < 0) {
+          level[static_cast<std::size_t>(w)] = level[static_cast<std::size_t>(u)] + 1;
+          touched.push_back(w);
+        }
+    }
+    return level[static_cast<std::size_t>(touched.back())];
+  };
+  std::vector<int> order;
+  order.reserve(static_cast<std::size_t>(n));
+  std::vector<char> numbered(static_cast<std::size_t>(n), 0);
+  std::vector<int> touched;
+  for (int seed = 0; seed < n; ++seed) {
+    if (numbered[static_cast<std::size_t>(seed)]) continue;
+    // Pseudo-peripheral root (George & Liu): jump to a smallest-degree vertex of the last level
+    // while the eccentricity grows.
+    int root = seed, depth = levels_from(root, touched);
+    for (int tries = 0; tries < 8; ++tries) {
+      int best = -1;
+      for (int u : touched)
+        if (level[static_cast<std::size_t>(u)] == depth &&
+            (best < 0 || degree[static_cast<std::size_t>(u)] < degree[static_cast<std::size_t>(best)]))
+          best = u;
+      for (int u : touched) level[static_cast<std::size_t>(u)] = -1;
+      const int next_depth = levels_from(best, touched);
+      if (next_depth <= depth) {
+        for (int u : touched) level[static_cast<std::size_t>(u)] = -1;
+        break;
+      }
+      root = best;
+      depth = next_depth;
+      if (tries == 7)
+        for (int u : touched) level[static_cast<std::size_t>(u)] = -1;
+    }
+    for (int u : touched) level[static_cast<std::size_t>(u)] = -1;
+    // Cuthill-McKee from the root.
+    const std::size_t start = order.size();
+    order.push_back(root);
+    numbered[static_cast<std::size_t>(root)] = 1;
+    std::vector<int> next;
+    for (std::size_t q = start; q < order.size(); ++q) {
+      next.clear();
+      for (int w : adjacent[static_cast<std::size_t>(order[q])])
+        if (!numbered[static_cast<std::size_t>(w)]) {
+          numbered[static_cast<std::size_t>(w)] = 1;
+          next.push_back(w);
+        }
+      std::sort(next.begin(), next.end(), [&](int x, int y) {
+        const int dx = degree[static_cast<std::size_t>(x)], dy = degree[static_cast<std::size_t>(y)];
+        return dx != dy ? dx < dy : x < y;
+      });
+      order.insert(order.end(), next.begin(), next.end());
+    }
+  }
+  std::reverse(order.begin(), order.end());
+  return order;
+}
+
+std::string default_solver_name() {
+#ifdef REMORA_WITH_GPL_SOLVERS
+  return "cholmod";
+#else
+  return "ldlt";
+#endif
+}
+
+std::vector<std::string> solver_names() {
+  std::vector<std::string> names = {"ldlt", "llt", "banded", "cg", "bicgstab", "lu"};
+#ifdef REMORA_WITH_GPL_SOLVERS
+  names.insert(names.begin(), "cholmod");
+#endif
+  return names;
+}
+
+std::unique_ptr<Solver> make_solver(const SolverOptions& options) {
+  const std::string name = options.name.empty() ? default_solver_name() : options.name;
+  if (options.ordering != "amd" && options.ordering != "metis")
+    throw InvalidArgument("solver ordering '" + options.ordering + "' is unknown; use amd or metis");
+  if (!(options.tolerance > 0) || !std::isfinite(options.tolerance))
+    throw InvalidArgument("solver tolerance must be positive and finite");
+  if (options.max_iterations < 0) throw InvalidArgument("solver max_iterations must be >= 0");
+  using AmdLdlt = Eigen::SimplicialLDLT<Sparse, Eigen::Lower, Eigen::AMDOrdering<int>>;
+  using AmdLlt = Eigen::SimplicialLLT<Sparse, Eigen::Lower, Eigen::AMDOrdering<int>>;
+  if (name == "ldlt") return std::make_unique<SimplicialSolver<AmdLdlt>>("ldlt");
+  if (name == "llt") return std::make_unique<SimplicialSolver<AmdLlt>>("llt");
+  if (name == "banded") return std::make_unique<BandedSolver>(options);
+  if (name == "cg") {
+    if (options.preconditioner == "jacobi")
+      return std::make_unique<IterativeSolver<Eigen::ConjugateGradient<
+          Sparse, Eigen::Lower | Eigen::Upper, Eigen::DiagonalPreconditioner<double>>>>(
+          "cg (jacobi)", true, options);
+    if (options.preconditioner == "ichol")
+      return std::make_unique<IterativeSolver<Eigen::ConjugateGradient<
+          Sparse, Eigen::Lower | Eigen::Upper,
+          Eigen::IncompleteCholesky<double, Eigen::Lower, Eigen::AMDOrdering<int>>>>>(
+          "cg (ichol)", true, options);
+    throw InvalidArgument("cg preconditioner '" + options.preconditioner +
+                          "' is unknown; use jacobi or ichol");
+  }
+  if (name == "bicgstab")
+    return std::make_unique<
+        IterativeSolver<Eigen::BiCGSTAB<Sparse, Eigen::DiagonalPreconditioner<double>>>>(
+        "bicgstab", false, options);
+#ifdef REMORA_WITH_GPL_SOLVERS
+  if (name == "cholmod") return std::make_unique<CholmodSolver>(options.ordering == "metis");
+  if (name == "lu") return std::make_unique<LuSolver<Eigen::UmfPackLU<Sparse>>>();
+#else
+  if (name == "lu")
+    return std::make_unique<LuSolver<Eigen::SparseLU<Sparse, Eigen::COLAMDOrdering<int>>>>();
+#endif
+  std::string known;
+  for (const auto& n : solver_names()) known += (known.empty() ? "" : ", ") + n;
+  throw InvalidArgument("unknown solver '" + name + "'; this build has: " + known);
+}
+
+} // namespace remora

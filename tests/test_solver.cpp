@@ -1,0 +1,192 @@
+// The solver suite: every solver agrees with a direct one on the same k-harmonic systems, the
+// numbers-only refactorization reuses the analysis, failures are errors and never garbage, and
+// reverse Cuthill-McKee shrinks the band of a scrambled grid.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <numeric>
+#include <random>
+
+#include "remora/common/error.h"
+#include "remora/linalg/kharmonic.h"
+#include "remora/linalg/solver.h"
+#include "remora/mesh/primitives.h"
+
+namespace remora {
+namespace {
+
+/// A k-harmonic system on a sphere: the cap z > 0.2 is handle 0, z < -0.6 fixed, the rest free.
+KHarmonicSystem sphere_system(int k, AreaWeights areas) {
+  const Mesh mesh = make_icosphere(4);
+  Region region{std::vector<int>(mesh.n_vertices(), Region::kFree)};
+  for (auto v : mesh.vertices()) {
+    const double z = mesh.point(v)[2];
+    if (z > 0.6) region.label[static_cast<std::size_t>(v.idx())] = 0;
+    if (z < -0.6) region.label[static_cast<std::size_t>(v.idx())] = Region::kFixed;
+  }
+  return assemble_kharmonic(mesh, region, {.k = k, .areas = areas});
+}
+
+Eigen::MatrixXd block_rhs(const KHarmonicSystem& s) {
+  Eigen::MatrixXd c = Eigen::MatrixXd::Zero(s.coupling.cols(), 3);
+  std::mt19937 rng(1);
+  for (Eigen::Index i = 0; i < c.rows(); ++i)
+    for (int j = 0; j < 3; ++j) c(i, j) = static_cast<double>(rng() % 1000) / 1000.0;
+  return s.rhs(c);
+}
+
+double relative_difference(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
+  return (a - b).norm() / b.norm();
+}
+
+TEST(Solver, EverySolverAgreesWithTheDirectOneOnTheSymmetricSystem) {
+  for (int k = 1; k <= 3; ++k) {
+    const KHarmonicSystem s = sphere_system(k, AreaWeights::Mean);
+    const Eigen::MatrixXd b = block_rhs(s);
+    auto reference = make_solver({.name = "ldlt"});
+    reference->compute(s.matrix);
+    const Eigen::MatrixXd x = reference->solve(b);
+    EXPECT_LE((s.matrix * x - b).norm() / b.norm(), 1e-10);
+    std::vector<SolverOptions> all;
+    for (const std::string& name : solver_names()) all.push_back({.name = name});
+    all.push_back({.name = "cg", .preconditioner = "ichol"});
+#ifdef REMORA_WITH_GPL_SOLVERS
+    all.push_back({.name = "cholmod", .ordering = "metis"});
+#endif
+    for (SolverOptions o : all) {
+      o.tolerance = 1e-12;
+      auto solver = make_solver(o);
+      SCOPED_TRACE(testing::Message() << solver->name() << " k " << k);
+      solver->compute(s.matrix);
+      EXPECT_LE(relative_difference(solver->solve(b), x), 1e-8);
+    }
+  }
+}
+
+TEST(Solver, UnsymmetricSystemIsSolvedByLuAndBicgstab) {
+  const KHarmonicSystem s = sphere_system(2, AreaWeights::Mixed);
+  const KHarmonicSystem scaled = sphere_system(2, AreaWeights::MixedSymmetric);
+  const Eigen::MatrixXd b = block_rhs(s), b_scaled = block_rhs(scaled);
+  auto reference = make_solver({.name = "ldlt"});
+  reference->compute(scaled.matrix);
+  const Eigen::MatrixXd x = reference->solve(b_scaled); // the same solution (rows scaled)
+  for (const std::string name : {"lu", "bicgstab"}) {
+    auto solver = make_solver({.name = name, .tolerance = 1e-13});
+    SCOPED_TRACE(name);
+    solver->compute(s.matrix);
+    EXPECT_LE(relative_difference(solver->solve(b), x), 1e-8);
+  }
+}
+
+TEST(Solver, RefactorizationReusesTheAnalysis) {
+  const KHarmonicSystem s = sphere_system(2, AreaWeights::Mean);
+  const Eigen::MatrixXd b = block_rhs(s);
+  for (const std::string& name : solver_names()) {
+    if (name == "bicgstab" || name == "lu") continue;
+    auto solver = make_solver({.name = name, .tolerance = 1e-12});
+    SCOPED_TRACE(name);
+    solver->compute(s.matrix);
+    const Eigen::MatrixXd x = solver->solve(b);
+    const SparseMatrix doubled = 2.0 * s.matrix;
+    solver->factorize(doubled); // same pattern, new values
+    EXPECT_LE(relative_difference(solver->solve(b), 0.5 * x), 1e-8);
+  }
+}
+
+TEST(Solver, IterativeSolversReportIterationsAndUseTheStartValue) {
+  const KHarmonicSystem s = sphere_system(2, AreaWeights::Mean);
+  const Eigen::MatrixXd b = block_rhs(s);
+  auto cg = make_solver({.name = "cg", .tolerance = 1e-10});
+  cg->compute(s.matrix);
+  const Eigen::MatrixXd x = cg->solve(b);
+  const int cold = cg->stats().iterations;
+  EXPECT_GT(cold, 10);
+  EXPECT_LE(cg->stats().residual, 1e-10);
+  const Eigen::MatrixXd close = x + 1e-6 * Eigen::MatrixXd::Ones(x.rows(), x.cols());
+  cg->solve(b, &close);
+  EXPECT_LT(cg->stats().iterations, cold);
+}
+
+TEST(Solver, FailuresAreErrorsNeverGarbage) {
+  const KHarmonicSystem s = sphere_system(2, AreaWeights::Mean);
+  const Eigen::MatrixXd b = block_rhs(s);
+  auto cg = make_solver({.name = "cg", .max_iterations = 3});
+  cg->compute(s.matrix);
+  try {
+    cg->solve(b);
+    ADD_FAILURE() << "cg with 3 iterations converged";
+  } catch (const NumericalError& e) {
+    EXPECT_NE(std::string(e.what()).find("no convergence after 3 iterations"), std::string::npos)
+        << e.what();
+  }
+  // An indefinite matrix: every Cholesky-type solver refuses it.
+  const SparseMatrix indefinite = -s.matrix;
+  for (const std::string& name : solver_names()) {
+    if (name == "cg" || name == "bicgstab" || name == "lu") continue;
+    auto solver = make_solver({.name = name});
+    SCOPED_TRACE(name);
+    EXPECT_THROW(solver->compute(indefinite), NumericalError);
+  }
+  EXPECT_THROW(make_solver({.name = "magic"}), InvalidArgument);
+  EXPECT_THROW(make_solver({.name = "cg", .preconditioner = "magic"}), InvalidArgument);
+  EXPECT_THROW(make_solver({.name = "", .ordering = "magic"}), InvalidArgument);
+  auto ldlt = make_solver({.name = "ldlt"});
+  ldlt->compute(s.matrix);
+  EXPECT_THROW(ldlt->solve(Eigen::MatrixXd::Zero(3, 1)), InvalidArgument);
+  Eigen::MatrixXd nan = b;
+  nan(0, 0) = std::nan("");
+  EXPECT_THROW(ldlt->solve(nan), InvalidArgument);
+}
+
+TEST(Solver, BandTooWideIsRefusedBeforeAllocating) {
+  const KHarmonicSystem s = sphere_system(2, AreaWeights::Mean);
+  auto banded = make_solver({.name = "banded", .max_band_bytes = 1000});
+  try {
+    banded->analyze(s.matrix);
+    ADD_FAILURE() << "no error";
+  } catch (const NumericalError& e) {
+    EXPECT_NE(std::string(e.what()).find("half-bandwidth"), std::string::npos) << e.what();
+  }
+}
+
+TEST(Solver, ReverseCuthillMcKeeShrinksTheBandOfAScrambledGrid) {
+  const int nx = 30, ny = 20;
+  const int n = nx * ny;
+  std::vector<int> scramble(static_cast<std::size_t>(n));
+  std::iota(scramble.begin(), scramble.end(), 0);
+  std::shuffle(scramble.begin(), scramble.end(), std::mt19937(4));
+  std::vector<Eigen::Triplet<double>> t;
+  auto id = [&](int i, int j) { return scramble[static_cast<std::size_t>(j * nx + i)]; };
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) {
+      t.emplace_back(id(i, j), id(i, j), 4.0);
+      if (i + 1 < nx) {
+        t.emplace_back(id(i, j), id(i + 1, j), -1.0);
+        t.emplace_back(id(i + 1, j), id(i, j), -1.0);
+      }
+      if (j + 1 < ny) {
+        t.emplace_back(id(i, j), id(i, j + 1), -1.0);
+        t.emplace_back(id(i, j + 1), id(i, j), -1.0);
+      }
+    }
+  SparseMatrix a(n, n);
+  a.setFromTriplets(t.begin(), t.end());
+  const std::vector<int> perm = reverse_cuthill_mckee(a);
+  std::vector<int> sorted = perm;
+  std::sort(sorted.begin(), sorted.end());
+  for (int i = 0; i < n; ++i) ASSERT_EQ(sorted[static_cast<std::size_t>(i)], i);
+  std::vector<int> position(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) position[static_cast<std::size_t>(perm[static_cast<std::size_t>(i)])] = i;
+  int band = 0, scrambled = 0;
+  for (int j = 0; j < n; ++j)
+    for (SparseMatrix::InnerIterator it(a, j); it; ++it) {
+      scrambled = std::max(scrambled, std::abs(static_cast<int>(it.row()) - j));
+      band = std::max(band, std::abs(position[static_cast<std::size_t>(it.row())] -
+                                     position[static_cast<std::size_t>(j)]));
+    }
+  EXPECT_GT(scrambled, 300);
+  EXPECT_LE(band, ny + 1); // the short side of the grid, plus one
+}
+
+} // namespace
+} // namespace remora
