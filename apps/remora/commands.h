@@ -9,5 +9,6 @@ namespace remora::cli {
 void add_info_command(CLI::App& app);
 void add_convert_command(CLI::App& app);
 void add_remesh_command(CLI::App& app);
+void add_bench_command(CLI::App& app);
 
 } // namespace remora::cli
