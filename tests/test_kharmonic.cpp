@@ -61,7 +61,8 @@ TEST(KHarmonic, ConstantsAreInTheKernelForEveryKAndWeighting) {
       const Eigen::VectorXd ones_f = Eigen::VectorXd::Ones(s.matrix.rows());
       const Eigen::VectorXd ones_c = Eigen::VectorXd::Ones(s.coupling.cols());
       const Eigen::VectorXd residual = s.matrix * ones_f + s.coupling * ones_c;
-      EXPECT_LE(residual.cwiseAbs().maxCoeff(), 1e-10 * s.matrix.cwiseAbs().sum() / static_cast<double>(ones_f.size()));
+      EXPECT_LE(residual.cwiseAbs().maxCoeff(),
+                1e-10 * s.matrix.cwiseAbs().sum() / static_cast<double>(ones_f.size()));
     }
 }
 
@@ -120,32 +121,32 @@ double radial_solution(int k, double r, double inner, double outer) {
 TEST(KHarmonic, ConvergesToTheRadialSolutionsUnderRefinement) {
   const double inner = 0.25, outer = 0.75;
   for (int k = 1; k <= 2; ++k)
-  for (AreaWeights w : {AreaWeights::Mean, AreaWeights::MixedSymmetric}) {
-    std::vector<double> errors;
-    for (int rings : {8, 16, 32}) {
-      const Mesh mesh = make_disc(rings, 6, 1.0);
-      const Region region = disc_region(mesh, inner, outer);
-      const KHarmonicSystem s = assemble_kharmonic(mesh, region, {.k = k, .areas = w});
-      const Eigen::VectorXd x = solve_scalar(mesh, s, [&](VertexHandle v) {
-        return region.label[static_cast<std::size_t>(v.idx())] == 0 ? 1.0 : 0.0;
-      });
-      double worst = 0;
-      for (std::size_t r = 0; r < s.free_vertices.size(); ++r) {
-        const double rad = radius(mesh, VertexHandle(s.free_vertices[r]));
-        worst = std::max(worst, std::abs(x[static_cast<Eigen::Index>(r)] -
-                                         radial_solution(k, rad, inner, outer)));
+    for (AreaWeights w : {AreaWeights::Mean, AreaWeights::MixedSymmetric}) {
+      std::vector<double> errors;
+      for (int rings : {8, 16, 32}) {
+        const Mesh mesh = make_disc(rings, 6, 1.0);
+        const Region region = disc_region(mesh, inner, outer);
+        const KHarmonicSystem s = assemble_kharmonic(mesh, region, {.k = k, .areas = w});
+        const Eigen::VectorXd x = solve_scalar(mesh, s, [&](VertexHandle v) {
+          return region.label[static_cast<std::size_t>(v.idx())] == 0 ? 1.0 : 0.0;
+        });
+        double worst = 0;
+        for (std::size_t r = 0; r < s.free_vertices.size(); ++r) {
+          const double rad = radius(mesh, VertexHandle(s.free_vertices[r]));
+          worst = std::max(worst, std::abs(x[static_cast<Eigen::Index>(r)] -
+                                           radial_solution(k, rad, inner, outer)));
+        }
+        errors.push_back(worst);
       }
-      errors.push_back(worst);
+      SCOPED_TRACE(testing::Message() << "k " << k << " " << to_string(w) << " errors " << errors[0]
+                                      << " " << errors[1] << " " << errors[2]);
+      // Measured: k = 1 second order (errors 2.6e-3, 4.2e-4, 8.8e-5); k = 2 first order (6.3e-2,
+      // 3.8e-2, 2.2e-2), since the clamped condition u' = 0 comes from the constrained rings.
+      const double rate = k == 1 ? 3.0 : 1.6;
+      EXPECT_LT(errors[1], errors[0] / rate);
+      EXPECT_LT(errors[2], errors[1] / rate);
+      EXPECT_LT(errors[2], k == 1 ? 2e-4 : 3e-2);
     }
-    SCOPED_TRACE(testing::Message() << "k " << k << " " << to_string(w) << " errors " << errors[0] << " " << errors[1]
-                                    << " " << errors[2]);
-    // Measured: k = 1 second order (errors 2.6e-3, 4.2e-4, 8.8e-5); k = 2 first order (6.3e-2,
-    // 3.8e-2, 2.2e-2), since the clamped condition u' = 0 comes from the constrained rings.
-    const double rate = k == 1 ? 3.0 : 1.6;
-    EXPECT_LT(errors[1], errors[0] / rate);
-    EXPECT_LT(errors[2], errors[1] / rate);
-    EXPECT_LT(errors[2], k == 1 ? 2e-4 : 3e-2);
-  }
 }
 
 TEST(KHarmonic, SymmetricFormsAreSymmetricAndTheMixedOneIsNot) {
@@ -159,8 +160,10 @@ TEST(KHarmonic, SymmetricFormsAreSymmetricAndTheMixedOneIsNot) {
   }
   const Region region = disc_region(mesh, 0.2, 0.8);
   for (int k = 1; k <= 3; ++k) {
-    const KHarmonicSystem mixed = assemble_kharmonic(mesh, region, {.k = k, .areas = AreaWeights::Mixed});
-    const KHarmonicSystem mean = assemble_kharmonic(mesh, region, {.k = k, .areas = AreaWeights::Mean});
+    const KHarmonicSystem mixed =
+        assemble_kharmonic(mesh, region, {.k = k, .areas = AreaWeights::Mixed});
+    const KHarmonicSystem mean =
+        assemble_kharmonic(mesh, region, {.k = k, .areas = AreaWeights::Mean});
     const KHarmonicSystem scaled =
         assemble_kharmonic(mesh, region, {.k = k, .areas = AreaWeights::MixedSymmetric});
     auto asymmetry = [](const SparseMatrix& a) {
@@ -172,7 +175,9 @@ TEST(KHarmonic, SymmetricFormsAreSymmetricAndTheMixedOneIsNot) {
     EXPECT_GT(asymmetry(mixed.matrix), 1e-3) << "k " << k;
     EXPECT_FALSE(mixed.symmetric);
     // The mixed system and the area-scaled one have the same solutions.
-    auto lift = [&](VertexHandle v) { return region.label[static_cast<std::size_t>(v.idx())] == 0 ? 1.0 : 0.0; };
+    auto lift = [&](VertexHandle v) {
+      return region.label[static_cast<std::size_t>(v.idx())] == 0 ? 1.0 : 0.0;
+    };
     const Eigen::VectorXd a = solve_scalar(mesh, mixed, lift, "lu");
     const Eigen::VectorXd b = solve_scalar(mesh, scaled, lift, "ldlt");
     EXPECT_LE((a - b).cwiseAbs().maxCoeff(), 1e-10) << "k " << k;
@@ -216,7 +221,8 @@ TEST(KHarmonic, AFreeRegionReachingTheMeshBoundaryUsesTheNaturalCondition) {
   for (auto v : mesh.vertices()) {
     const Vec3& p = mesh.point(v);
     if (radius(mesh, v) < 0.15) region.label[static_cast<std::size_t>(v.idx())] = 0;
-    if (mesh.is_boundary(v) && p[0] < 0) region.label[static_cast<std::size_t>(v.idx())] = Region::kFixed;
+    if (mesh.is_boundary(v) && p[0] < 0)
+      region.label[static_cast<std::size_t>(v.idx())] = Region::kFixed;
   }
   const KHarmonicSystem s = assemble_kharmonic(mesh, region, {.k = 1});
   const Eigen::VectorXd x = solve_scalar(mesh, s, [&](VertexHandle v) {

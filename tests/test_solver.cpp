@@ -176,7 +176,8 @@ TEST(Solver, ReverseCuthillMcKeeShrinksTheBandOfAScrambledGrid) {
   std::sort(sorted.begin(), sorted.end());
   for (int i = 0; i < n; ++i) ASSERT_EQ(sorted[static_cast<std::size_t>(i)], i);
   std::vector<int> position(static_cast<std::size_t>(n));
-  for (int i = 0; i < n; ++i) position[static_cast<std::size_t>(perm[static_cast<std::size_t>(i)])] = i;
+  for (int i = 0; i < n; ++i)
+    position[static_cast<std::size_t>(perm[static_cast<std::size_t>(i)])] = i;
   int band = 0, scrambled = 0;
   for (int j = 0; j < n; ++j)
     for (SparseMatrix::InnerIterator it(a, j); it; ++it) {

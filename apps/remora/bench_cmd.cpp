@@ -135,23 +135,23 @@ void add_bench_command(CLI::App& app) {
       names = solver_names();
       names.insert(names.begin() + (names.front() == "cholmod" ? 1 : 0), "cholmod-metis");
       names.insert(names.end() - 2, "cg-ichol");
-      if (names.front() != "cholmod") names.erase(std::remove(names.begin(), names.end(), "cholmod-metis"), names.end());
+      if (names.front() != "cholmod")
+        names.erase(std::remove(names.begin(), names.end(), "cholmod-metis"), names.end());
     }
-    nlohmann::json out = {{"mesh", a->mesh},
-                          {"vertices", mesh.n_vertices()},
-                          {"load_s", load_s},
-                          {"remesh_s", remesh_s},
-                          {"k", a->k},
-                          {"supports", nlohmann::json::array()}};
+    nlohmann::json out = {{"mesh", a->mesh},  {"vertices", mesh.n_vertices()},
+                          {"load_s", load_s}, {"remesh_s", remesh_s},
+                          {"k", a->k},        {"supports", nlohmann::json::array()}};
     if (!a->json)
-      std::cout << fmt::format("# Solvers on {} ({} vertices after remeshing in {:.2f} s), k = {}\n",
-                               a->mesh, mesh.n_vertices(), remesh_s, a->k);
+      std::cout << fmt::format(
+          "# Solvers on {} ({} vertices after remeshing in {:.2f} s), k = {}\n", a->mesh,
+          mesh.n_vertices(), remesh_s, a->k);
     const Eigen::MatrixXd positions = positions_matrix(mesh);
     for (int size : a->sizes) {
       const std::size_t handle = static_cast<std::size_t>(size) / 19; // 5 % of the disc
       const std::vector<int> order =
           geodesic_order(mesh, seed, handle + static_cast<std::size_t>(size));
-      if (order.size() < handle + static_cast<std::size_t>(size) || order.size() >= mesh.n_vertices())
+      if (order.size() < handle + static_cast<std::size_t>(size) ||
+          order.size() >= mesh.n_vertices())
         throw InvalidArgument(fmt::format(
             "bench solvers: the mesh has {} vertices, too few for a support of {} free vertices "
             "with a fixed rest; use a larger mesh or smaller --sizes",
@@ -161,7 +161,8 @@ void add_bench_command(CLI::App& app) {
         region.label[static_cast<std::size_t>(order[i])] = i < handle ? 0 : Region::kFree;
       // The edit: the handle moves by a tenth of the support's extent along x, y and z.
       double extent = 0;
-      for (int v : order) extent = std::max(extent, (mesh.point(VertexHandle(v)) - mesh.point(seed)).norm());
+      for (int v : order)
+        extent = std::max(extent, (mesh.point(VertexHandle(v)) - mesh.point(seed)).norm());
       const Eigen::RowVector3d shift(0.1 * extent, 0.05 * extent, -0.08 * extent);
 
       std::vector<Row> rows;
@@ -227,21 +228,23 @@ void add_bench_command(CLI::App& app) {
       if (a->json) continue;
       std::cout << fmt::format("\n## {} free vertices, handle {}, assembly {:.3f} s\n\n", size,
                                handle, assemble_s);
-      std::cout << "| solver | system | precompute s | 3 solves ms | iterations | residual | "
-                   "factor MB | max diff / shift | note |\n|---|---|---:|---:|---:|---:|---:|---:|---|\n";
+      std::cout
+          << "| solver | system | precompute s | 3 solves ms | iterations | residual | "
+             "factor MB | max diff / shift | note |\n|---|---|---:|---:|---:|---:|---:|---:|---|\n";
       for (const Row& r : rows)
-        std::cout << fmt::format("| {} | {} | {:.3f} | {:.1f} | {} | {:.1e} | {:.1f} | {:.1e} | {} |\n",
-                                 r.solver, r.system, r.precompute_s, 1e3 * r.solve_s, r.iterations,
-                                 r.residual, static_cast<double>(r.factor_bytes) / 1e6,
-                                 r.max_difference, r.note);
+        std::cout << fmt::format(
+            "| {} | {} | {:.3f} | {:.1f} | {} | {:.1e} | {:.1f} | {:.1e} | {} |\n", r.solver,
+            r.system, r.precompute_s, 1e3 * r.solve_s, r.iterations, r.residual,
+            static_cast<double>(r.factor_bytes) / 1e6, r.max_difference, r.note);
     }
     if (a->json) {
       std::cout << out.dump(2) << "\n";
       return;
     }
-    std::cout << "\nThe paper's Table 1 (2004, 3 GHz P4), precomputation / 3 solutions: 15k free "
-                 "vertices: iterative 7.2 s / 7.4 s, multigrid 4.5 s / 0.8 s, direct 2.4 s / 0.07 s; "
-                 "31k: 15.2 s / 25.5 s, 8.8 s / 2.0 s, 6.7 s / 0.16 s.\n";
+    std::cout
+        << "\nThe paper's Table 1 (2004, 3 GHz P4), precomputation / 3 solutions: 15k free "
+           "vertices: iterative 7.2 s / 7.4 s, multigrid 4.5 s / 0.8 s, direct 2.4 s / 0.07 s; "
+           "31k: 15.2 s / 25.5 s, 8.8 s / 2.0 s, 6.7 s / 0.16 s.\n";
   });
 }
 

@@ -61,8 +61,8 @@ struct KHarmonicOptions {
 };
 
 struct KHarmonicSystem {
-  SparseMatrix matrix;   ///< free × free
-  SparseMatrix coupling; ///< free × constrained
+  SparseMatrix matrix;                   ///< free × free
+  SparseMatrix coupling;                 ///< free × constrained
   std::vector<int> free_vertices;        ///< row r of the system is vertex free_vertices[r]
   std::vector<int> constrained_vertices; ///< column c of coupling is this vertex
   std::vector<int> row_of;               ///< vertex -> row, or -1 when not free

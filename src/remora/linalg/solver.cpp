@@ -100,7 +100,9 @@ private:
 
 #ifdef REMORA_WITH_GPL_SOLVERS
 struct ExposedCholmod : Eigen::CholmodSupernodalLLT<Sparse, Eigen::Lower> {
-  const cholmod_factor* factor() const { return static_cast<const cholmod_factor*>(m_cholmodFactor); }
+  const cholmod_factor* factor() const {
+    return static_cast<const cholmod_factor*>(m_cholmodFactor);
+  }
 };
 
 class CholmodSolver final : public Solver {
@@ -241,19 +243,22 @@ public:
     n_ = static_cast<int>(a.rows());
     perm_ = reverse_cuthill_mckee(a);
     inverse_.assign(perm_.size(), 0);
-    for (std::size_t i = 0; i < perm_.size(); ++i) inverse_[static_cast<std::size_t>(perm_[i])] = static_cast<int>(i);
+    for (std::size_t i = 0; i < perm_.size(); ++i)
+      inverse_[static_cast<std::size_t>(perm_[i])] = static_cast<int>(i);
     kd_ = 0;
     for (int j = 0; j < a.outerSize(); ++j)
       for (Sparse::InnerIterator it(a, j); it; ++it)
         kd_ = std::max(kd_, std::abs(inverse_[static_cast<std::size_t>(it.row())] -
                                      inverse_[static_cast<std::size_t>(j)]));
     stats_.bandwidth = kd_;
-    const std::size_t bytes = static_cast<std::size_t>(kd_ + 1) * static_cast<std::size_t>(n_) * sizeof(double);
+    const std::size_t bytes =
+        static_cast<std::size_t>(kd_ + 1) * static_cast<std::size_t>(n_) * sizeof(double);
     if (bytes > options_.max_band_bytes)
       throw NumericalError(fmt::format(
           "banded: after reverse Cuthill-McKee the half-bandwidth is {} and the band would take "
           "{:.1f} GB (limit {:.1f} GB); use cholmod or ldlt, whose fill is far smaller",
-          kd_, static_cast<double>(bytes) / 1e9, static_cast<double>(options_.max_band_bytes) / 1e9));
+          kd_, static_cast<double>(bytes) / 1e9,
+          static_cast<double>(options_.max_band_bytes) / 1e9));
   }
   void factorize(const Sparse& a) override {
     require_finite(a, "banded");
@@ -265,8 +270,8 @@ public:
         const int pi = inverse_[static_cast<std::size_t>(it.row())];
         const int pj = inverse_[static_cast<std::size_t>(j)];
         if (pi < pj) continue;
-        band_[static_cast<std::size_t>(pi - pj) + static_cast<std::size_t>(pj) * static_cast<std::size_t>(ld)] =
-            it.value();
+        band_[static_cast<std::size_t>(pi - pj) +
+              static_cast<std::size_t>(pj) * static_cast<std::size_t>(ld)] = it.value();
       }
     int info = 0;
     dpbtrf_("L", &n_, &kd_, band_.data(), &ld, &info);
@@ -343,7 +348,8 @@ std::vector<int> reverse_cuthill_mckee(const Sparse& a) {
       int best = -1;
       for (int u : touched)
         if (level[static_cast<std::size_t>(u)] == depth &&
-            (best < 0 || degree[static_cast<std::size_t>(u)] < degree[static_cast<std::size_t>(best)]))
+            (best < 0 ||
+             degree[static_cast<std::size_t>(u)] < degree[static_cast<std::size_t>(best)]))
           best = u;
       for (int u : touched) level[static_cast<std::size_t>(u)] = -1;
       const int next_depth = levels_from(best, touched);
@@ -370,7 +376,8 @@ std::vector<int> reverse_cuthill_mckee(const Sparse& a) {
           next.push_back(w);
         }
       std::sort(next.begin(), next.end(), [&](int x, int y) {
-        const int dx = degree[static_cast<std::size_t>(x)], dy = degree[static_cast<std::size_t>(y)];
+        const int dx = degree[static_cast<std::size_t>(x)],
+                  dy = degree[static_cast<std::size_t>(y)];
         return dx != dy ? dx < dy : x < y;
       });
       order.insert(order.end(), next.begin(), next.end());
@@ -399,7 +406,8 @@ std::vector<std::string> solver_names() {
 std::unique_ptr<Solver> make_solver(const SolverOptions& options) {
   const std::string name = options.name.empty() ? default_solver_name() : options.name;
   if (options.ordering != "amd" && options.ordering != "metis")
-    throw InvalidArgument("solver ordering '" + options.ordering + "' is unknown; use amd or metis");
+    throw InvalidArgument("solver ordering '" + options.ordering +
+                          "' is unknown; use amd or metis");
   if (!(options.tolerance > 0) || !std::isfinite(options.tolerance))
     throw InvalidArgument("solver tolerance must be positive and finite");
   if (options.max_iterations < 0) throw InvalidArgument("solver max_iterations must be >= 0");

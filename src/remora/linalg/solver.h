@@ -30,22 +30,22 @@
 namespace remora {
 
 struct SolverOptions {
-  std::string name;          ///< empty = default_solver_name()
-  std::string ordering = "amd"; ///< cholmod: "amd" or "metis"
+  std::string name;                      ///< empty = default_solver_name()
+  std::string ordering = "amd";          ///< cholmod: "amd" or "metis"
   std::string preconditioner = "jacobi"; ///< cg: "jacobi" or "ichol"
-  double tolerance = 1e-10;  ///< iterative: relative residual |b - Ax| / |b| per column
-  int max_iterations = 0;    ///< iterative: 0 = 10 × the dimension
+  double tolerance = 1e-10;              ///< iterative: relative residual |b - Ax| / |b| per column
+  int max_iterations = 0;                ///< iterative: 0 = 10 × the dimension
   /// banded: refuse when the band storage would exceed this many bytes (the band of a large
   /// surface mesh grows like sqrt(n), its storage like n^1.5).
   std::size_t max_band_bytes = std::size_t(4) << 30;
 };
 
 struct SolverStats {
-  int iterations = 0;      ///< iterative: the most any column needed in the last solve
-  double residual = 0.0;   ///< iterative: the largest relative residual of the last solve
+  int iterations = 0;           ///< iterative: the most any column needed in the last solve
+  double residual = 0.0;        ///< iterative: the largest relative residual of the last solve
   std::size_t factor_bytes = 0; ///< direct: memory of the factor (values and indices)
   std::size_t factor_nonzeros = 0;
-  int bandwidth = 0;       ///< banded: half-bandwidth after the ordering
+  int bandwidth = 0; ///< banded: half-bandwidth after the ordering
 };
 
 class Solver {
@@ -64,7 +64,8 @@ public:
     factorize(a);
   }
   /// Solves A X = B for every column of B. `guess` (iterative solvers only) is the start value.
-  virtual Eigen::MatrixXd solve(const Eigen::MatrixXd& b, const Eigen::MatrixXd* guess = nullptr) = 0;
+  virtual Eigen::MatrixXd solve(const Eigen::MatrixXd& b,
+                                const Eigen::MatrixXd* guess = nullptr) = 0;
   virtual SolverStats stats() const { return stats_; }
 
 protected:
