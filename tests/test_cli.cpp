@@ -173,5 +173,24 @@ TEST_F(Cli, RemeshRejectsBadOptionsBeforeWorking) {
     EXPECT_EQ(entry.path().filename(), "sphere.off") << "left behind: " << entry.path();
 }
 
+TEST_F(Cli, BenchSolversAgreeAndRefuseSupportsLargerThanTheMesh) {
+  const fs::path in = dir_ / "sphere.off";
+  write_mesh(in.string(), make_icosphere(4)); // 2,562 vertices
+  const CliRun r = run("bench solvers " + in.string() +
+                       " --no-remesh --sizes 1000 --solvers ldlt,cg,multigrid --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  const auto& rows = j["supports"][0]["rows"];
+  ASSERT_EQ(rows.size(), 3u);
+  for (const auto& row : rows) {
+    EXPECT_EQ(row["note"].get<std::string>().find("error"), std::string::npos) << row;
+    EXPECT_LE(row["residual"].get<double>(), 1e-9) << row;
+    EXPECT_LE(row["max_difference"].get<double>(), 1e-6) << row;
+  }
+  const CliRun too_big = run("bench solvers " + in.string() + " --no-remesh --sizes 5000");
+  EXPECT_EQ(too_big.exit_code, 1);
+  EXPECT_NE(too_big.err.find("too few for a support of 5000"), std::string::npos) << too_big.err;
+}
+
 } // namespace
 } // namespace remora

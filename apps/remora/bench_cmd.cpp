@@ -133,12 +133,14 @@ void add_bench_command(CLI::App& app) {
       }
     std::vector<std::string> names = a->solvers;
     if (names.empty()) {
-      names = solver_names();
-      names.insert(names.begin() + (names.front() == "cholmod" ? 1 : 0), "cholmod-metis");
-      names.insert(names.end() - 2, "cg-ichol");
+      // Every solver of this build, the variants (METIS ordering, incomplete Cholesky) next to
+      // their plain forms, the unsymmetric ones last but multigrid.
+      for (const std::string& name : solver_names()) {
+        names.push_back(name);
+        if (name == "cholmod") names.push_back("cholmod-metis");
+        if (name == "cg") names.push_back("cg-ichol");
+      }
       names.push_back("multigrid");
-      if (names.front() != "cholmod")
-        names.erase(std::remove(names.begin(), names.end(), "cholmod-metis"), names.end());
     }
     nlohmann::json out = {{"mesh", a->mesh},  {"vertices", mesh.n_vertices()},
                           {"load_s", load_s}, {"remesh_s", remesh_s},

@@ -191,9 +191,9 @@ Eigen::MatrixXd MultigridSolver::solve(const Eigen::MatrixXd& vertex_values) {
                           std::to_string(meshes_[0].n_vertices()) + " vertices");
   if (!vertex_values.allFinite())
     throw InvalidArgument("multigrid: the vertex values contain a NaN or Inf");
+  if (options_.method == MultigridMethod::Cascadic) return solve_cascadic(vertex_values);
   const KHarmonicSystem& system = active_[0]->system;
   const Eigen::MatrixXd b = system.rhs(system.gather_constrained(vertex_values));
-  if (options_.method == MultigridMethod::Cascadic) return solve_cascadic(vertex_values);
   // Preconditioned conjugate gradients, one column at a time, from zero.
   const Level& fine = *active_[0];
   const int limit =
