@@ -192,5 +192,94 @@ TEST_F(Cli, BenchSolversAgreeAndRefuseSupportsLargerThanTheMesh) {
   EXPECT_NE(too_big.err.find("too few for a support of 5000"), std::string::npos) << too_big.err;
 }
 
+// docs/editing.md's examples, run as documented: every ```json block on the bundled bunny, and
+// the quick-flag form of the first one, which must give the same mesh.
+TEST_F(Cli, EditRunsTheDocumentedExamples) {
+  const std::string bunny = std::string(REMORA_REPO_DATA) + "/bunny.ply";
+  const std::string doc = slurp(fs::path(REMORA_REPO_DATA) / ".." / "docs" / "editing.md");
+  std::vector<std::string> examples;
+  for (std::size_t at = doc.find("```json\n"); at != std::string::npos;
+       at = doc.find("```json\n", at + 1)) {
+    const std::size_t begin = at + 8, end = doc.find("```", begin);
+    examples.push_back(doc.substr(begin, end - begin));
+  }
+  ASSERT_GE(examples.size(), 3u);
+  const std::size_t faces = read_mesh(bunny).mesh.n_faces();
+  for (std::size_t i = 0; i < examples.size(); ++i) {
+    const fs::path edit = dir_ / ("example" + std::to_string(i) + ".json");
+    const fs::path out = dir_ / ("example" + std::to_string(i) + ".ply");
+    std::ofstream(edit) << examples[i];
+    const CliRun r =
+        run("edit " + bunny + " --edit " + edit.string() + " -o " + out.string() + " --json");
+    ASSERT_EQ(r.exit_code, 0) << examples[i] << r.err;
+    const nlohmann::json j = nlohmann::json::parse(r.out);
+    EXPECT_GT(j["result"]["max_move_relative"].get<double>(), 1e-3) << i;
+    EXPECT_LT(j["result"]["max_move_relative"].get<double>(), 0.2) << i;
+    EXPECT_EQ(j["phong"]["encoded"], j["region"]["support_vertices"]) << i;
+    EXPECT_EQ(read_mesh(out.string()).mesh.n_faces(), faces);
+  }
+  const fs::path quick = dir_ / "quick.ply";
+  const CliRun r = run("edit " + bunny + " -o " + quick.string() +
+                       " --support-sphere -0.03,0.15,0,0.05 --handle-sphere -0.03,0.17,0,0.015"
+                       " --translate 0,0.02,0 --report");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("detail retention"), std::string::npos) << r.out;
+  const Mesh a = read_mesh(quick.string()).mesh,
+             b = read_mesh((dir_ / "example0.ply").string()).mesh;
+  ASSERT_EQ(a.n_vertices(), b.n_vertices());
+  double difference = 0;
+  for (const VertexHandle v : a.vertices())
+    difference = std::max(difference, (a.point(v) - b.point(v)).norm());
+  EXPECT_LT(difference, 1e-12);
+}
+
+TEST_F(Cli, EditRefusesBadRequestsAndWritesNothing) {
+  const fs::path in = dir_ / "sphere.off";
+  write_mesh(in.string(), make_icosphere(3)); // radius 1
+  const fs::path out = dir_ / "out.ply";
+  const std::string base = "edit " + in.string() + " -o " + out.string() + " ";
+  auto write = [&](const std::string& name, const std::string& text) {
+    std::ofstream(dir_ / name) << text;
+    return (dir_ / name).string();
+  };
+  const std::string ok_handles =
+      R"("handles": [{"region": {"sphere": {"center": [0, 0, 1], "radius": 0.3}}}])";
+  const struct {
+    std::string args;
+    int code;
+    std::string message;
+  } cases[] = {
+      {"--edit " + write("broken.json", "{\"support\": [1, 2"), 1, "not valid JSON"},
+      {"--edit " + (dir_ / "missing.json").string(), 1, "cannot open"},
+      {"--edit " + write("key.json", "{\"suport\": [1], " + ok_handles + "}"), 1,
+       "unknown key 'suport'"},
+      {"--edit " +
+           write("empty.json", R"({"support": {"sphere": {"center": [5, 5, 5], "radius": 0.1}}, )" +
+                                   ok_handles + "}"),
+       1, "selects no vertex"},
+      {"--edit " + write("outside.json",
+                         R"({"support": {"sphere": {"center": [0, 0, -1], "radius": 0.5}}, )" +
+                             ok_handles + "}"),
+       1, "outside the support"},
+      {"--edit " +
+           write("ids.json", R"({"support": [1, 2, 100000], "handles": [{"region": [1]}]})"),
+       1, "vertex 100000 of the file"},
+      {"--support-sphere 0,0,1,0.8 --handle-sphere 0,0,1,0.2 --translate 1,nan,0", 1,
+       "--translate"},
+      {"--support-sphere 0,0,1,0.8 --handle-sphere 0,0,1 --translate 1,0,0", 1,
+       "--handle-sphere: expected 4 numbers"},
+      {"--support-sphere 0,0,1,0.8", 2, "requires"},
+      {"", 1, "nothing to edit"},
+      {"--support-sphere 0,0,1,0.8 --handle-sphere 0,0,1,0.2 --solver ldlt --areas mixed", 1,
+       "symmetric positive definite"},
+  };
+  for (const auto& c : cases) {
+    const CliRun r = run(base + c.args);
+    EXPECT_EQ(r.exit_code, c.code) << c.args << "\n" << r.err;
+    EXPECT_NE(r.err.find(c.message), std::string::npos) << c.args << "\n" << r.err;
+    EXPECT_FALSE(fs::exists(out)) << c.args;
+  }
+}
+
 } // namespace
 } // namespace remora

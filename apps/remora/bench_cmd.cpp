@@ -9,13 +9,13 @@
 #include <algorithm>
 #include <chrono>
 #include <iostream>
-#include <queue>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
 #include "remora/common/error.h"
+#include "remora/geometry/selection.h"
 #include "remora/linalg/kharmonic.h"
 #include "remora/linalg/solver.h"
 #include "remora/mesh/io.h"
@@ -29,34 +29,6 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
-}
-
-// Vertices in order of geodesic (edge-path) distance from `seed`, at most `count` of them.
-std::vector<int> geodesic_order(const Mesh& mesh, VertexHandle seed, std::size_t count) {
-  std::vector<double> dist(mesh.n_vertices(), std::numeric_limits<double>::infinity());
-  std::vector<char> done(mesh.n_vertices(), 0);
-  using Item = std::pair<double, int>;
-  std::priority_queue<Item, std::vector<Item>, std::greater<>> queue;
-  dist[static_cast<std::size_t>(seed.idx())] = 0;
-  queue.push({0.0, seed.idx()});
-  std::vector<int> order;
-  while (!queue.empty() && order.size() < count) {
-    const auto [d, i] = queue.top();
-    queue.pop();
-    if (done[static_cast<std::size_t>(i)]) continue;
-    done[static_cast<std::size_t>(i)] = 1;
-    order.push_back(i);
-    const VertexHandle v(i);
-    for (auto h : mesh.voh_range(v)) {
-      const VertexHandle w = mesh.to_vertex_handle(h);
-      const double nd = d + mesh.calc_edge_length(h);
-      if (nd < dist[static_cast<std::size_t>(w.idx())]) {
-        dist[static_cast<std::size_t>(w.idx())] = nd;
-        queue.push({nd, w.idx()});
-      }
-    }
-  }
-  return order;
 }
 
 struct Row {
@@ -85,6 +57,7 @@ nlohmann::json to_json(const Row& r) {
 void add_bench_command(CLI::App& app) {
   auto* bench = app.add_subcommand("bench", "Benchmarks (docs/benchmarks.md)");
   bench->require_subcommand(1);
+  add_bench_edit_command(*bench);
   auto* cmd = bench->add_subcommand(
       "solvers", "The paper's Table 1: every solver on the thin-plate system of geodesic supports");
   struct Args {

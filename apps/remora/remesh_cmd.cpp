@@ -4,7 +4,6 @@
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
-#include <unistd.h>
 
 #include "commands.h"
 #include "remora/mesh/io.h"
@@ -14,31 +13,6 @@
 namespace remora::cli {
 
 namespace {
-
-// A one-line progress display on stderr, only when stderr is a terminal.
-class ProgressLine {
-public:
-  ProgressLine() : enabled_(::isatty(STDERR_FILENO) == 1) {}
-  ~ProgressLine() { finish(); }
-  void update(std::string_view phase, int step, int steps) {
-    if (!enabled_) return;
-    const int width = 30;
-    const int filled = steps > 0 ? width * step / steps : width;
-    std::fprintf(stderr, "\r%-15.*s [%s%s] %d/%d", static_cast<int>(phase.size()), phase.data(),
-                 std::string(static_cast<std::size_t>(filled), '#').c_str(),
-                 std::string(static_cast<std::size_t>(width - filled), '.').c_str(), step, steps);
-    std::fflush(stderr);
-    shown_ = true;
-  }
-  void finish() {
-    if (shown_) std::fprintf(stderr, "\r%60s\r", "");
-    shown_ = false;
-  }
-
-private:
-  bool enabled_;
-  bool shown_ = false;
-};
 
 void print_remesh_report(std::ostream& os, const RemeshReport& r) {
   os << fmt::format("target edge length l = {:.6g}\n", r.target_length);

@@ -181,14 +181,17 @@ public:
       : name_(std::move(name)), spd_(spd), options_(options) {}
   std::string name() const override { return name_; }
   bool needs_spd() const override { return spd_; }
+  // Eigen's iterations keep a view of the matrix: hold a copy so that the caller's may go.
   void analyze(const Sparse& a) override {
     require_square(a, name_);
-    iteration_.analyzePattern(a);
+    matrix_ = a;
+    iteration_.analyzePattern(matrix_);
     n_ = a.rows();
   }
   void factorize(const Sparse& a) override {
     require_finite(a, name_);
-    iteration_.factorize(a);
+    matrix_ = a;
+    iteration_.factorize(matrix_);
     if (iteration_.info() != Eigen::Success)
       throw NumericalError(name_ + ": the preconditioner could not be built (a zero or negative "
                                    "pivot); try the jacobi preconditioner or a direct solver");
@@ -227,6 +230,7 @@ private:
   std::string name_;
   bool spd_;
   SolverOptions options_;
+  Sparse matrix_;
   Iteration iteration_;
   Eigen::Index n_ = 0;
 };

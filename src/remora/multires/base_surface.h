@@ -1,0 +1,63 @@
+// The base surface S of the editor (paper §3, Fig. 3): a low-pass filtered copy of the user's
+// mesh with the same connectivity, by one or more steps of implicit fairing (Desbrun, Meyer,
+// Schröder, Barr 1999), (M − t W) S = M X, with W and M the Laplacian and lumped mass of the
+// mesh's intrinsic Delaunay triangulation (geometry/intrinsic.h). That operator is robust on
+// needles and zero-area faces, where the mesh's own cotan weights are huge or negative and would
+// make the system indefinite; docs/editing.md says why this choice and what it measured.
+//
+// Strength: t = σ², σ = smoothing × the mesh's mean edge length. A Laplacian eigenfunction of
+// wavelength λ is scaled by 1 / (1 + (2πσ/λ)²) per step: wavelengths below 2πσ lose at least half.
+// The filter is factored once (a Jacobi-preconditioned CG set-up) and applied to any positions.
+#pragma once
+
+#include <cstddef>
+#include <memory>
+
+#include <Eigen/Core>
+
+#include "remora/geometry/intrinsic.h"
+#include "remora/linalg/solver.h"
+#include "remora/mesh/mesh.h"
+
+namespace remora {
+
+struct LowPassOptions {
+  /// σ in units of the mean edge length; 0 turns the filter into the identity.
+  double smoothing = 2.0;
+  /// Implicit steps with the same operator (a steeper cut-off).
+  int steps = 1;
+  /// Relative residual of every CG solve.
+  double tolerance = 1e-10;
+};
+
+struct LowPassStats {
+  double sigma = 0.0;                 ///< absolute σ
+  IntrinsicLaplacian laplacian_stats; ///< flips, clamps (weights and mass are not kept here)
+  int iterations = 0; ///< CG iterations of the last apply(), the most over the columns
+};
+
+class LowPassFilter {
+public:
+  /// Builds the operator of `mesh` (its points define the metric). Throws InvalidArgument for a
+  /// negative or non-finite smoothing, or steps < 1.
+  LowPassFilter(const Mesh& mesh, const LowPassOptions& options = {});
+  LowPassFilter(LowPassFilter&&) noexcept;
+  LowPassFilter& operator=(LowPassFilter&&) noexcept;
+  ~LowPassFilter();
+
+  /// The filtered values of `values` (n_vertices × any number of columns, e.g. positions).
+  /// Isolated vertices keep their values. Throws InvalidArgument for a wrong row count and
+  /// NumericalError if CG does not converge.
+  Eigen::MatrixXd apply(const Eigen::MatrixXd& values);
+
+  const LowPassStats& stats() const { return stats_; }
+
+private:
+  Eigen::Index n_ = 0;
+  Eigen::VectorXd mass_;
+  std::unique_ptr<Solver> solver_; // null when smoothing == 0
+  int steps_ = 1;
+  LowPassStats stats_;
+};
+
+} // namespace remora

@@ -1,0 +1,651 @@
+#include "remora/multires/editor.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <optional>
+#include <utility>
+
+#include <Eigen/Geometry>
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "remora/common/error.h"
+#include "remora/common/parallel.h"
+#include "remora/geometry/laplacian.h"
+#include "remora/geometry/measures.h"
+#include "remora/multires/multigrid.h"
+
+namespace remora {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double ms_since(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+int largest(const std::array<double, 3>& a) {
+  return a[0] >= a[1] && a[0] >= a[2] ? 0 : (a[1] >= a[2] ? 1 : 2);
+}
+
+} // namespace
+
+// ---- transforms ------------------------------------------------------------------------------
+
+Transform identity_transform() {
+  Transform t = Transform::Zero();
+  t.leftCols<3>().setIdentity();
+  return t;
+}
+
+Transform translation(const Eigen::Vector3d& offset) {
+  Transform t = identity_transform();
+  t.col(3) = offset;
+  return t;
+}
+
+Transform rotation(const Eigen::Vector3d& axis, double radians, const Eigen::Vector3d& center) {
+  if (!axis.allFinite() || !(axis.norm() > 0.0) || !std::isfinite(radians) || !center.allFinite())
+    throw InvalidArgument("rotation: the axis must be finite and non-zero, the angle and the "
+                          "center finite");
+  Transform t;
+  const Eigen::Matrix3d r = Eigen::AngleAxisd(radians, axis.normalized()).toRotationMatrix();
+  t.leftCols<3>() = r;
+  t.col(3) = center - r * center;
+  return t;
+}
+
+Transform scaling(const Eigen::Vector3d& factors, const Eigen::Vector3d& center) {
+  if (!factors.allFinite() || !center.allFinite())
+    throw InvalidArgument("scaling: the factors and the center must be finite");
+  Transform t = Transform::Zero();
+  t.leftCols<3>() = factors.asDiagonal();
+  t.col(3) = center - factors.cwiseProduct(center);
+  return t;
+}
+
+Transform compose(const Transform& a, const Transform& b) {
+  Transform t;
+  t.leftCols<3>() = a.leftCols<3>() * b.leftCols<3>();
+  t.col(3) = a.leftCols<3>() * b.col(3) + a.col(3);
+  return t;
+}
+
+std::string to_string(DetailMode mode) {
+  switch (mode) {
+  case DetailMode::Normal:
+    return "normal";
+  case DetailMode::Displacement:
+    return "displacement";
+  case DetailMode::None:
+    return "none";
+  }
+  return "?";
+}
+
+DetailMode parse_detail_mode(const std::string& name) {
+  if (name == "normal") return DetailMode::Normal;
+  if (name == "displacement") return DetailMode::Displacement;
+  if (name == "none") return DetailMode::None;
+  throw InvalidArgument(
+      fmt::format("unknown detail mode '{}': use normal (the paper), displacement or none", name));
+}
+
+// ---- the editor ------------------------------------------------------------------------------
+
+namespace {
+
+struct RegionState {
+  std::vector<int> input_label; // per O vertex: kFixed, kFree or handle j
+  std::vector<int> base_label;  // per B vertex
+  int handles = 0;
+  std::vector<int> free_vertices; // B vertices, in the row order of `basis`
+  Eigen::MatrixXd basis;          // n_free × (3 + 4h)
+  std::vector<std::vector<int>> handle_base;
+  std::vector<Eigen::Vector3d> handle_centers;
+  Eigen::MatrixXd rest;         // B0
+  Eigen::MatrixXd rest_normals; // of B0
+  std::vector<int> encoded;     // O vertices, in the order of `details`
+  std::vector<PhongDetail> details;
+  std::vector<Eigen::Vector3d> rest_offsets; // DetailMode::Displacement: p − b on B0
+  std::vector<int> affected;                 // B vertices whose normal can change
+  std::vector<Transform> transforms;
+  Eigen::MatrixXd current_base, current_normals, current_positions;
+  bool dirty = true;
+};
+
+} // namespace
+
+struct Editor::Impl {
+  EditorOptions options;
+  Mesh input;
+  Eigen::MatrixXd input_positions;
+  TriangleTopology input_topology;
+  std::optional<LowPassFilter> filter;
+  Mesh base;
+  TriangleTopology topology;
+  Eigen::MatrixXd base_rest; // B
+  std::vector<SurfacePoint> base_on_input, input_on_base;
+  std::vector<std::pair<int, int>> negative_edges; // of B
+  std::unique_ptr<MultigridSolver> multigrid;
+  EditReport report;
+  std::unique_ptr<RegionState> region;
+
+  void progress(std::string_view phase, int step, int steps) const {
+    if (options.progress) options.progress(phase, step, steps);
+  }
+  std::string solver_name(bool symmetric) const {
+    if (!options.solver.name.empty()) return options.solver.name;
+    return symmetric ? default_solver_name() : "lu";
+  }
+  RegionState& state() {
+    if (!region) throw InvalidArgument("no region yet: call set_region() first");
+    return *region;
+  }
+  void update();
+};
+
+namespace {
+
+void check_options(const EditorOptions& o) {
+  if (o.system.k < 1 || o.system.k > 3)
+    throw InvalidArgument(fmt::format("k = {} is not supported: use 1, 2 or 3", o.system.k));
+  const bool symmetric = o.system.areas != AreaWeights::Mixed;
+  const std::string& name = o.solver.name;
+  if (name == "multigrid") {
+    if (!symmetric)
+      throw InvalidArgument("the multigrid solver needs a symmetric system: use the mean or "
+                            "mixed-symmetric area weights");
+    if (!o.remesh)
+      throw InvalidArgument("the multigrid solver builds its hierarchy by remeshing the base; it "
+                            "does not run in the no-remesh mode");
+    return;
+  }
+  if (name.empty()) return;
+  const auto solver = make_solver(o.solver); // throws for an unknown name
+  if (solver->needs_spd() && !symmetric)
+    throw InvalidArgument(fmt::format(
+        "solver {} needs a symmetric positive definite system, and the mixed area weights give "
+        "an unsymmetric one: use lu or bicgstab, or the mean or mixed-symmetric weights",
+        name));
+}
+
+} // namespace
+
+Editor::Editor(Mesh mesh, EditorOptions options) : impl_(std::make_unique<Impl>()) {
+  Impl& m = *impl_;
+  check_options(options);
+  m.options = std::move(options);
+  if (mesh.n_faces() == 0) throw InvalidArgument("the mesh has no faces: nothing to edit");
+  if (mesh.has_vertex_status() && mesh.has_face_status()) {
+    for (const VertexHandle v : mesh.all_vertices())
+      if (mesh.status(v).deleted())
+        throw InvalidArgument("the mesh has deleted vertices: call garbage_collection() first");
+  }
+  m.input = std::move(mesh);
+  m.input_positions = positions_matrix(m.input);
+  if (!m.input_positions.allFinite())
+    throw InvalidArgument("the mesh has a non-finite coordinate (NaN or Inf)");
+  m.input_topology = triangle_topology(m.input);
+  m.report.input_vertices = m.input.n_vertices();
+  m.report.input_faces = m.input.n_faces();
+  m.report.remeshed = m.options.remesh;
+
+  // 2. The base surface S: low-pass filtered O, same connectivity.
+  m.progress("base surface", 0, 1);
+  auto t0 = Clock::now();
+  m.filter.emplace(m.input, m.options.base);
+  const Eigen::MatrixXd smooth = m.filter->apply(m.input_positions);
+  m.report.sigma = m.filter->stats().sigma;
+  m.report.intrinsic_flips = m.filter->stats().laplacian_stats.flips;
+  m.report.input_negative_weights = m.filter->stats().laplacian_stats.negative_before;
+  Mesh s = m.input;
+  for (const VertexHandle v : s.vertices()) {
+    const auto r = smooth.row(v.idx());
+    s.set_point(v, Vec3(r[0], r[1], r[2]));
+  }
+  m.report.milliseconds["base"] = ms_since(t0);
+
+  // 3. The base B: the area-equalizing remesh of S, with the correspondence.
+  t0 = Clock::now();
+  if (m.options.remesh) {
+    RemeshOptions ro = m.options.remesh_options;
+    ro.threads = m.options.threads;
+    ro.progress = [&m](std::string_view phase, int step, int steps) {
+      m.progress(fmt::format("remesh: {}", phase), step, steps);
+    };
+    RemeshResult r = remesh(s, ro);
+    m.report.base_target_length = r.report.target_length;
+    m.base = std::move(r.mesh);
+    m.base_on_input = std::move(r.output_on_input);
+    m.input_on_base = std::move(r.input_on_output);
+  } else {
+    m.base = std::move(s);
+    m.base_on_input.assign(m.base.n_vertices(), SurfacePoint{FaceHandle(), {1.0, 0.0, 0.0}});
+    for (std::size_t f = 0; f < m.input_topology.faces.size(); ++f)
+      for (int k = 0; k < 3; ++k) {
+        SurfacePoint& sp = m.base_on_input[static_cast<std::size_t>(
+            m.input_topology.faces[f][static_cast<std::size_t>(k)])];
+        if (sp.face.is_valid()) continue;
+        sp.face = FaceHandle(static_cast<int>(f));
+        sp.bary = {0.0, 0.0, 0.0};
+        sp.bary[static_cast<std::size_t>(k)] = 1.0;
+      }
+    m.input_on_base = m.base_on_input;
+  }
+  m.topology = triangle_topology(m.base);
+  m.base_rest = positions_matrix(m.base);
+  m.report.milliseconds["remesh"] = ms_since(t0);
+  m.report.base_vertices = m.base.n_vertices();
+  m.report.base_faces = m.base.n_faces();
+
+  t0 = Clock::now();
+  const Eigen::SparseMatrix<double> w = cotan_weights(m.base);
+  for (Eigen::Index c = 0; c < w.outerSize(); ++c)
+    for (Eigen::SparseMatrix<double>::InnerIterator it(w, c); it; ++it)
+      if (it.row() < it.col() && it.value() < 0.0)
+        m.negative_edges.emplace_back(static_cast<int>(it.row()), static_cast<int>(it.col()));
+  m.report.base_symmetry_defect = laplacian_symmetry_defect(m.base);
+  m.report.base_quality = mesh_quality(m.base);
+  m.report.milliseconds["base report"] = ms_since(t0);
+}
+
+Editor::Editor(Editor&&) noexcept = default;
+Editor& Editor::operator=(Editor&&) noexcept = default;
+Editor::~Editor() = default;
+
+void Editor::set_region(const std::vector<int>& support,
+                        const std::vector<std::vector<int>>& handles) {
+  Impl& m = *impl_;
+  const auto t_start = Clock::now();
+  const auto n = static_cast<int>(m.input.n_vertices());
+  if (support.empty()) throw InvalidArgument("the support is empty: paint at least one vertex");
+  if (handles.empty())
+    throw InvalidArgument("no handle: paint at least one handle inside the support");
+  auto state = std::make_unique<RegionState>();
+  RegionState& r = *state;
+  r.handles = static_cast<int>(handles.size());
+  r.input_label.assign(static_cast<std::size_t>(n), Region::kFixed);
+  for (const int v : support) {
+    if (v < 0 || v >= n)
+      throw InvalidArgument(
+          fmt::format("support vertex {} is out of range: the mesh has {} vertices (ids 0 to {})",
+                      v, n, n - 1));
+    r.input_label[static_cast<std::size_t>(v)] = Region::kFree;
+  }
+  for (int j = 0; j < r.handles; ++j) {
+    const auto& h = handles[static_cast<std::size_t>(j)];
+    if (h.empty()) throw InvalidArgument(fmt::format("handle {} has no vertex", j));
+    Eigen::Vector3d center = Eigen::Vector3d::Zero();
+    for (const int v : h) {
+      if (v < 0 || v >= n)
+        throw InvalidArgument(
+            fmt::format("handle {}: vertex {} is out of range: the mesh has {} vertices", j, v, n));
+      int& label = r.input_label[static_cast<std::size_t>(v)];
+      if (label == Region::kFixed)
+        throw InvalidArgument(fmt::format(
+            "handle {}: vertex {} is outside the support; the support must contain every handle "
+            "(paint the support over the handles)",
+            j, v));
+      if (label >= 0 && label != j)
+        throw InvalidArgument(fmt::format(
+            "vertex {} is in handle {} and in handle {}; handles must not overlap", v, label, j));
+      label = j;
+      center += m.input_positions.row(v).transpose();
+    }
+    r.handle_centers.push_back(center / double(h.size()));
+  }
+
+  // Map the region onto the base: a base vertex takes the label of the input vertex nearest to
+  // its location (largest barycentric weight); then every painted input vertex claims the base
+  // vertex nearest to its own location, so that small handles and supports are not lost.
+  const auto nb = static_cast<std::size_t>(m.base.n_vertices());
+  r.base_label.assign(nb, Region::kFixed);
+  if (m.options.remesh) {
+    for (std::size_t v = 0; v < nb; ++v) {
+      const SurfacePoint& sp = m.base_on_input[v];
+      const int corner = m.input_topology.faces[static_cast<std::size_t>(sp.face.idx())]
+                                               [static_cast<std::size_t>(largest(sp.bary))];
+      r.base_label[v] = r.input_label[static_cast<std::size_t>(corner)];
+    }
+    for (int i = 0; i < n; ++i) {
+      const int label = r.input_label[static_cast<std::size_t>(i)];
+      const SurfacePoint& sp = m.input_on_base[static_cast<std::size_t>(i)];
+      if (label == Region::kFixed || !sp.face.is_valid()) continue;
+      const int w = m.topology.faces[static_cast<std::size_t>(sp.face.idx())]
+                                    [static_cast<std::size_t>(largest(sp.bary))];
+      int& bl = r.base_label[static_cast<std::size_t>(w)];
+      if (label >= 0 ? bl < 0 : bl == Region::kFixed) bl = label;
+    }
+  } else {
+    r.base_label = r.input_label;
+  }
+  r.handle_base.assign(static_cast<std::size_t>(r.handles), {});
+  for (std::size_t v = 0; v < nb; ++v)
+    if (r.base_label[v] >= 0)
+      r.handle_base[static_cast<std::size_t>(r.base_label[v])].push_back(static_cast<int>(v));
+  m.report.support_vertices = 0;
+  m.report.handle_vertices.assign(static_cast<std::size_t>(r.handles), 0);
+  for (const int label : r.input_label) {
+    if (label != Region::kFixed) ++m.report.support_vertices;
+    if (label >= 0) ++m.report.handle_vertices[static_cast<std::size_t>(label)];
+  }
+
+  // The region's figures, before the solve, so that a failing solve still reports them.
+  std::size_t free_count = 0, constrained = 0;
+  for (const int label : r.base_label) (label == Region::kFree ? free_count : constrained)++;
+  m.report.free_base_vertices = free_count;
+  m.report.constrained_base_vertices = constrained;
+  m.report.handle_base_vertices.clear();
+  for (const auto& h : r.handle_base) m.report.handle_base_vertices.push_back(h.size());
+  m.report.negative_weights_in_support = 0;
+  for (const auto& [a, b] : m.negative_edges)
+    if (r.base_label[static_cast<std::size_t>(a)] == Region::kFree ||
+        r.base_label[static_cast<std::size_t>(b)] == Region::kFree)
+      ++m.report.negative_weights_in_support;
+
+  // The system on the base, factored once; the 3 + 4h basis functions.
+  const Region region{r.base_label};
+  const std::string on_base =
+      m.options.remesh
+          ? fmt::format("on the remeshed base (edge length {:.4g}): ", m.report.base_target_length)
+          : std::string("on the mesh itself: ");
+  auto t0 = Clock::now();
+  const int columns = 3 + 4 * r.handles;
+  const std::string name = m.solver_name(m.options.system.areas != AreaWeights::Mixed);
+  std::unique_ptr<Solver> solver;
+  KHarmonicSystem system;
+  Eigen::MatrixXd values; // constrained values, one column per basis function
+  auto fill_values = [&](const std::vector<int>& vertices, Eigen::MatrixXd& out, bool by_vertex) {
+    out = Eigen::MatrixXd::Zero(by_vertex ? static_cast<Eigen::Index>(nb)
+                                          : static_cast<Eigen::Index>(vertices.size()),
+                                columns);
+    for (std::size_t c = 0; c < vertices.size(); ++c) {
+      const int v = vertices[c];
+      const int label = r.base_label[static_cast<std::size_t>(v)];
+      const Eigen::Index row = by_vertex ? v : static_cast<Eigen::Index>(c);
+      const Eigen::RowVector3d p = m.base_rest.row(v);
+      if (label == Region::kFixed) {
+        out.block<1, 3>(row, 0) = p;
+      } else if (label >= 0) {
+        out.block<1, 3>(row, 3 + 4 * label) = p;
+        out(row, 3 + 4 * label + 3) = 1.0;
+      }
+    }
+  };
+  try {
+    if (name == "multigrid") {
+      if (!m.multigrid) {
+        MultigridOptions mo;
+        mo.k = m.options.system.k;
+        mo.areas = m.options.system.areas;
+        mo.tolerance = m.options.solver.tolerance;
+        mo.threads = m.options.threads;
+        m.multigrid = std::make_unique<MultigridSolver>(m.base, mo);
+      }
+      m.multigrid->set_region(region);
+      m.report.milliseconds["assemble"] = 0.0;
+      m.report.milliseconds["factor"] = ms_since(t0);
+      t0 = Clock::now();
+      std::vector<int> all(nb);
+      for (std::size_t v = 0; v < nb; ++v) all[v] = static_cast<int>(v);
+      fill_values(all, values, true);
+      r.basis = m.multigrid->solve(values);
+      r.free_vertices = m.multigrid->fine_system().free_vertices;
+      int iterations = 0;
+      for (const auto& level : m.multigrid->stats())
+        iterations = std::max(iterations, level.iterations);
+      m.report.solver_stats = SolverStats{};
+      m.report.solver_stats.iterations = iterations;
+    } else {
+      system = assemble_kharmonic(m.base, region, m.options.system);
+      m.report.milliseconds["assemble"] = ms_since(t0);
+      t0 = Clock::now();
+      SolverOptions so = m.options.solver;
+      so.name = name;
+      solver = make_solver(so);
+      solver->compute(system.matrix);
+      m.report.milliseconds["factor"] = ms_since(t0);
+      t0 = Clock::now();
+      fill_values(system.constrained_vertices, values, false);
+      r.basis = solver->solve(system.rhs(values));
+      r.free_vertices = system.free_vertices;
+      m.report.solver_stats = solver->stats();
+    }
+  } catch (const InvalidArgument& e) {
+    throw InvalidArgument(on_base + e.what());
+  } catch (const NumericalError& e) {
+    throw NumericalError(on_base + e.what());
+  }
+  m.report.milliseconds["solve"] = ms_since(t0);
+  m.report.solver = name;
+  m.report.solves = columns;
+  if (!r.basis.allFinite())
+    throw NumericalError(on_base + "the solver returned non-finite values; try a direct solver");
+
+  // B0: the fill-in with the handles undeformed.
+  t0 = Clock::now();
+  r.rest = m.base_rest;
+  for (std::size_t row = 0; row < r.free_vertices.size(); ++row) {
+    Eigen::RowVector3d p = r.basis.block<1, 3>(static_cast<Eigen::Index>(row), 0);
+    for (int j = 0; j < r.handles; ++j)
+      p += r.basis.block<1, 3>(static_cast<Eigen::Index>(row), 3 + 4 * j);
+    r.rest.row(r.free_vertices[row]) = p;
+  }
+  r.rest_normals = vertex_normals(m.topology, r.rest);
+
+  // Phong details of the painted input vertices against B0.
+  std::vector<int> starts;
+  for (int i = 0; i < n; ++i) {
+    const SurfacePoint& sp = m.input_on_base[static_cast<std::size_t>(i)];
+    if (r.input_label[static_cast<std::size_t>(i)] == Region::kFixed || !sp.face.is_valid())
+      continue;
+    r.encoded.push_back(i);
+    starts.push_back(sp.face.idx());
+  }
+  Eigen::MatrixXd points(static_cast<Eigen::Index>(r.encoded.size()), 3);
+  for (std::size_t e = 0; e < r.encoded.size(); ++e)
+    points.row(static_cast<Eigen::Index>(e)) = m.input_positions.row(r.encoded[e]);
+  r.details = encode_phong(m.topology, r.rest, r.rest_normals, points, starts, m.options.phong,
+                           &m.report.phong, m.options.threads);
+  if (m.options.details == DetailMode::Displacement) {
+    r.rest_offsets.resize(r.details.size());
+    for (std::size_t e = 0; e < r.details.size(); ++e) {
+      PhongDetail foot = r.details[e];
+      foot.offset = 0.0;
+      foot.residual = false;
+      r.rest_offsets[e] = points.row(static_cast<Eigen::Index>(e)).transpose() -
+                          decode_phong(m.topology, r.rest, r.rest_normals, foot);
+    }
+  }
+  m.report.milliseconds["encode"] = ms_since(t0);
+
+  // The base vertices whose normals can change: every corner of a face with a moving vertex.
+  std::vector<char> affected(nb, 0);
+  for (const auto& f : m.topology.faces)
+    if (r.base_label[static_cast<std::size_t>(f[0])] != Region::kFixed ||
+        r.base_label[static_cast<std::size_t>(f[1])] != Region::kFixed ||
+        r.base_label[static_cast<std::size_t>(f[2])] != Region::kFixed)
+      for (const int v : f) affected[static_cast<std::size_t>(v)] = 1;
+  for (std::size_t v = 0; v < nb; ++v)
+    if (affected[v]) r.affected.push_back(static_cast<int>(v));
+
+  r.transforms.assign(static_cast<std::size_t>(r.handles), identity_transform());
+  r.current_base = r.rest;
+  r.current_normals = r.rest_normals;
+  r.current_positions = m.input_positions;
+  r.dirty = true;
+
+  m.region = std::move(state);
+  m.report.milliseconds["set_region"] = ms_since(t_start);
+}
+
+int Editor::handle_count() const {
+  return impl_->region ? impl_->region->handles : 0;
+}
+
+Eigen::Vector3d Editor::handle_center(int handle) const {
+  const RegionState& r = impl_->state();
+  if (handle < 0 || handle >= r.handles)
+    throw InvalidArgument(
+        fmt::format("handle {} does not exist: there are {} handles", handle, r.handles));
+  return r.handle_centers[static_cast<std::size_t>(handle)];
+}
+
+void Editor::set_transform(int handle, const Transform& transform) {
+  RegionState& r = impl_->state();
+  if (handle < 0 || handle >= r.handles)
+    throw InvalidArgument(
+        fmt::format("handle {} does not exist: there are {} handles", handle, r.handles));
+  if (!transform.allFinite())
+    throw InvalidArgument(
+        fmt::format("the transform of handle {} has a NaN or infinite entry", handle));
+  r.transforms[static_cast<std::size_t>(handle)] = transform;
+  r.dirty = true;
+}
+
+const Transform& Editor::transform(int handle) const {
+  const RegionState& r = impl_->state();
+  if (handle < 0 || handle >= r.handles)
+    throw InvalidArgument(
+        fmt::format("handle {} does not exist: there are {} handles", handle, r.handles));
+  return r.transforms[static_cast<std::size_t>(handle)];
+}
+
+void Editor::Impl::update() {
+  RegionState& r = state();
+  if (!r.dirty) return;
+  const auto t0 = Clock::now();
+  // Blend: X_free = Φ_0 + Σ_j Φ_j [M_jᵀ; t_jᵀ].
+  Eigen::MatrixXd coefficients(3 + 4 * r.handles, 3);
+  coefficients.topRows<3>().setIdentity();
+  for (int j = 0; j < r.handles; ++j)
+    coefficients.block<4, 3>(3 + 4 * j, 0) = r.transforms[static_cast<std::size_t>(j)].transpose();
+  const Eigen::MatrixXd moved = r.basis * coefficients;
+  const int threads = options.threads;
+  parallel_for(r.free_vertices.size(), threads, [&](std::size_t row) {
+    r.current_base.row(r.free_vertices[row]) = moved.row(static_cast<Eigen::Index>(row));
+  });
+  for (int j = 0; j < r.handles; ++j) {
+    const Transform& t = r.transforms[static_cast<std::size_t>(j)];
+    for (const int v : r.handle_base[static_cast<std::size_t>(j)])
+      r.current_base.row(v) =
+          (t.leftCols<3>() * base_rest.row(v).transpose() + t.col(3)).transpose();
+  }
+  // Normals where they can change.
+  parallel_for(r.affected.size(), threads, [&](std::size_t a) {
+    const auto v = static_cast<std::size_t>(r.affected[a]);
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    for (int k = topology.vertex_offsets[v]; k < topology.vertex_offsets[v + 1]; ++k) {
+      const auto& f =
+          topology
+              .faces[static_cast<std::size_t>(topology.vertex_faces[static_cast<std::size_t>(k)])];
+      const Eigen::Vector3d p0 = r.current_base.row(f[0]);
+      const Eigen::Vector3d p1 = r.current_base.row(f[1]);
+      const Eigen::Vector3d p2 = r.current_base.row(f[2]);
+      sum += (p1 - p0).cross(p2 - p0);
+    }
+    const double len = sum.norm();
+    r.current_normals.row(static_cast<Eigen::Index>(v)) =
+        len > 0.0 ? Eigen::RowVector3d((sum / len).transpose()) : Eigen::RowVector3d::Zero();
+  });
+  // Decode.
+  parallel_for(r.encoded.size(), threads, [&](std::size_t e) {
+    const PhongDetail& d = r.details[e];
+    Eigen::Vector3d p;
+    switch (options.details) {
+    case DetailMode::Normal:
+      p = decode_phong(topology, r.current_base, r.current_normals, d);
+      break;
+    case DetailMode::Displacement:
+    case DetailMode::None: {
+      PhongDetail on_base = d;
+      on_base.offset = 0.0;
+      on_base.residual = false;
+      p = decode_phong(topology, r.current_base, r.current_normals, on_base);
+      if (options.details == DetailMode::Displacement) p += r.rest_offsets[e];
+      break;
+    }
+    }
+    r.current_positions.row(r.encoded[e]) = p.transpose();
+  });
+  r.dirty = false;
+  report.milliseconds["frame"] = ms_since(t0);
+}
+
+const Eigen::MatrixXd& Editor::positions() {
+  impl_->update();
+  return impl_->region->current_positions;
+}
+
+Mesh Editor::result() {
+  const Eigen::MatrixXd& p = positions();
+  Mesh out = impl_->input;
+  for (const int v : impl_->region->encoded)
+    out.set_point(VertexHandle(v), Vec3(p(v, 0), p(v, 1), p(v, 2)));
+  return out;
+}
+
+const Mesh& Editor::input() const {
+  return impl_->input;
+}
+const Mesh& Editor::base() const {
+  return impl_->base;
+}
+
+const Eigen::MatrixXd& Editor::base_positions() {
+  impl_->update();
+  return impl_->region->current_base;
+}
+
+Eigen::MatrixXd Editor::low_pass(const Eigen::MatrixXd& values) {
+  return impl_->filter->apply(values);
+}
+
+bool Editor::in_support(int vertex) const {
+  const RegionState& r = impl_->state();
+  if (vertex < 0 || vertex >= static_cast<int>(r.input_label.size()))
+    throw InvalidArgument(fmt::format("vertex {} is out of range", vertex));
+  return r.input_label[static_cast<std::size_t>(vertex)] != Region::kFixed;
+}
+
+const EditReport& Editor::report() const {
+  return impl_->report;
+}
+const EditorOptions& Editor::options() const {
+  return impl_->options;
+}
+
+nlohmann::json to_json(const EditReport& r) {
+  nlohmann::json j;
+  j["input"] = {{"vertices", r.input_vertices}, {"faces", r.input_faces}};
+  j["base"] = {{"vertices", r.base_vertices},
+               {"faces", r.base_faces},
+               {"remeshed", r.remeshed},
+               {"sigma", r.sigma},
+               {"intrinsic_flips", r.intrinsic_flips},
+               {"input_negative_cotan_weights", r.input_negative_weights},
+               {"target_length", r.base_target_length},
+               {"symmetry_defect", r.base_symmetry_defect},
+               {"quality", to_json(r.base_quality)}};
+  j["region"] = {{"support_vertices", r.support_vertices},
+                 {"handle_vertices", r.handle_vertices},
+                 {"free_base_vertices", r.free_base_vertices},
+                 {"constrained_base_vertices", r.constrained_base_vertices},
+                 {"handle_base_vertices", r.handle_base_vertices},
+                 {"negative_cotan_weights_in_support", r.negative_weights_in_support}};
+  j["solver"] = {{"name", r.solver},
+                 {"solves", r.solves},
+                 {"iterations", r.solver_stats.iterations},
+                 {"residual", r.solver_stats.residual},
+                 {"factor_bytes", r.solver_stats.factor_bytes}};
+  j["phong"] = {{"encoded", r.phong.encoded},
+                {"walk_steps", r.phong.walk_steps},
+                {"extrapolated", r.phong.extrapolated},
+                {"fallbacks", r.phong.fallbacks},
+                {"max_abs_offset", r.phong.max_abs_offset}};
+  j["milliseconds"] = r.milliseconds;
+  return j;
+}
+
+} // namespace remora

@@ -1,0 +1,166 @@
+// The multiresolution editor of Botsch & Kobbelt 2004 (§3, Fig. 3; basis functions of §6): the
+// whole pipeline behind one object.
+//
+//   Editor editor(mesh, options);        // 1-3: load O, base surface S (low-pass of O, same
+//                                        //      connectivity), area-equalizing remesh of S into
+//                                        //      the base B with its correspondence (cached here:
+//                                        //      every later region reuses it)
+//   editor.set_region(support, handles); // 4-5: paint on O, mapped onto B; solve Δ^k = 0 on B with
+//                                        //      the handles undeformed (B0), encode every vertex
+//                                        //      of O in the support as a Phong detail against B0,
+//                                        //      factor once, solve the 3 + 4h basis functions
+//   editor.set_transform(j, T);          // 6:   store T (affine 3×4) for handle j
+//   editor.positions() / result();       // 7:   blend the basis functions, decode: no solve
+//
+// Basis functions: the solution is linear in the constrained values, and handle j's values are
+// T_j [x; 1] of its rest positions, so with Φ_0 = the solution for the fixed vertices' x, y, z
+// (handles at 0) and Φ_j = the solutions for handle j's x, y, z and 1 (everything else at 0),
+//   X_free = Φ_0 + Σ_j Φ_j [M_jᵀ; t_jᵀ]     (T_j = [M_j | t_j]),
+// a product with an n_free × 4 block per handle (Botsch & Kobbelt 2004, "An intuitive framework
+// for real-time freeform modeling").
+//
+// O's connectivity is never changed. Vertices of O outside the support keep their positions bit
+// for bit. Errors throw InvalidArgument (bad ids, empty or inconsistent regions, NaN transforms)
+// or NumericalError (a solver that fails, e.g. BiCGSTAB on the "no remesh" baseline).
+#pragma once
+
+#include <array>
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <Eigen/Core>
+#include <nlohmann/json_fwd.hpp>
+
+#include "remora/geometry/quality.h"
+#include "remora/linalg/kharmonic.h"
+#include "remora/linalg/solver.h"
+#include "remora/mesh/mesh.h"
+#include "remora/multires/base_surface.h"
+#include "remora/multires/phong.h"
+#include "remora/remesh/remesh.h"
+
+namespace remora {
+
+/// An affine map x -> M x + t as the 3×4 matrix [M | t].
+using Transform = Eigen::Matrix<double, 3, 4>;
+
+Transform identity_transform();
+Transform translation(const Eigen::Vector3d& offset);
+/// Rotation by `radians` about `axis` (any non-zero length) through `center`.
+Transform rotation(const Eigen::Vector3d& axis, double radians, const Eigen::Vector3d& center);
+/// Scaling by `factors` along x, y, z about `center`.
+Transform scaling(const Eigen::Vector3d& factors, const Eigen::Vector3d& center);
+/// a ∘ b: first b, then a.
+Transform compose(const Transform& a, const Transform& b);
+
+/// How the vertices of O follow the deformed base.
+enum class DetailMode {
+  Normal,       ///< Phong: base point + offset along the interpolated normal (the paper)
+  Displacement, ///< base point + the rest-pose offset vector, not rotated (for comparison)
+  None,         ///< the base point alone: details are lost (for comparison)
+};
+std::string to_string(DetailMode mode);
+DetailMode parse_detail_mode(const std::string& name); ///< "normal", "displacement", "none"
+
+struct EditorOptions {
+  LowPassOptions base;                ///< the base surface's low-pass filter
+  bool remesh = true;                 ///< false: the "no remesh" baseline on O's own connectivity
+  RemeshOptions remesh_options = [] { ///< the base's remesh (target length 0.9 × mean edge)
+    RemeshOptions r;
+    r.compute_report = false;
+    return r;
+  }();
+  KHarmonicOptions system; ///< k and the area weights (Mean: the paper's SPD system)
+  /// By name (linalg/solver.h, plus "multigrid" for the remeshed base); empty = the default
+  /// direct solver for a symmetric system, "lu" for the Mixed one.
+  SolverOptions solver;
+  DetailMode details = DetailMode::Normal;
+  PhongOptions phong;
+  int threads = 0; ///< 0 = all hardware threads
+  /// Called at the start of every phase: (phase name, step, number of steps).
+  std::function<void(std::string_view phase, int step, int steps)> progress;
+};
+
+struct EditReport {
+  std::size_t input_vertices = 0, input_faces = 0;
+  std::size_t base_vertices = 0, base_faces = 0;
+  bool remeshed = true;
+  double sigma = 0.0; ///< the low-pass filter's length scale
+  std::size_t intrinsic_flips = 0, input_negative_weights = 0;
+  double base_target_length = 0.0;
+  double base_symmetry_defect = 0.0; ///< laplacian_symmetry_defect() of the base
+  MeshQuality base_quality;
+  // set_region
+  std::size_t support_vertices = 0;         ///< of O, handles included
+  std::vector<std::size_t> handle_vertices; ///< of O, per handle
+  std::size_t free_base_vertices = 0, constrained_base_vertices = 0;
+  std::vector<std::size_t> handle_base_vertices;
+  /// Edges of the system's mesh with a free end whose cotan weight is negative (none on a good
+  /// remesh; many on a scan's own connectivity).
+  std::size_t negative_weights_in_support = 0;
+  std::string solver;
+  SolverStats solver_stats;
+  int solves = 0; ///< right-hand sides solved (3 + 4h)
+  PhongStats phong;
+  /// Wall time in milliseconds: "base", "remesh", "set_region" (and its parts "assemble",
+  /// "factor", "solve", "encode"), "frame" (the last positions() that had work to do).
+  std::map<std::string, double> milliseconds;
+};
+
+nlohmann::json to_json(const EditReport& report);
+
+class Editor {
+public:
+  /// Steps 1-3. `mesh` must be a repaired mesh without deleted elements (read_mesh() gives one).
+  /// Throws InvalidArgument for an empty mesh, non-finite points or bad options.
+  explicit Editor(Mesh mesh, EditorOptions options = {});
+  Editor(Editor&&) noexcept;
+  Editor& operator=(Editor&&) noexcept;
+  ~Editor();
+
+  /// Steps 4-5. `support`: vertex ids of O, handles included; handles[j]: the ids of handle j,
+  /// each inside the support and disjoint from the others. Resets every transform to the
+  /// identity. Throws InvalidArgument for an empty support, no handle, an empty handle, an id out
+  /// of range, a handle vertex outside the support or in two handles, a support that maps to no
+  /// free base vertex, or a support component (on the base) with no constrained vertex; throws
+  /// NumericalError when the solver fails. On a throw the previous region stays in place.
+  void set_region(const std::vector<int>& support, const std::vector<std::vector<int>>& handles);
+
+  int handle_count() const;
+  /// The centroid of handle j's vertices on O (the default center of rotations and scalings).
+  Eigen::Vector3d handle_center(int handle) const;
+
+  /// Step 6: handle j's vertices go to T [x; 1] of their rest positions. Throws InvalidArgument
+  /// for j out of range or a non-finite T. Cheap: the work happens in positions().
+  void set_transform(int handle, const Transform& transform);
+  const Transform& transform(int handle) const;
+
+  /// Step 7: O's vertex positions under the current transforms (n_vertices × 3). Blends the basis
+  /// functions and decodes the details when a transform changed since the last call.
+  const Eigen::MatrixXd& positions();
+  /// O with positions(): same connectivity, bit-identical points outside the support.
+  Mesh result();
+
+  const Mesh& input() const;
+  /// The base B (the remeshed base surface, or S itself without remeshing) at rest.
+  const Mesh& base() const;
+  /// B's vertex positions under the current transforms (B0 where nothing moved).
+  const Eigen::MatrixXd& base_positions();
+  /// Applies the editor's low-pass filter (the one that made S) to per-vertex values of O.
+  Eigen::MatrixXd low_pass(const Eigen::MatrixXd& values);
+  /// Whether vertex i of O is in the current support (handles included).
+  bool in_support(int vertex) const;
+
+  const EditReport& report() const;
+  const EditorOptions& options() const;
+
+private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+} // namespace remora

@@ -1,0 +1,127 @@
+// The intrinsic Delaunay Laplacian (geometry/intrinsic.h) and the low-pass filter built on it
+// (multires/base_surface.h).
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "remora/common/error.h"
+#include "remora/geometry/intrinsic.h"
+#include "remora/geometry/laplacian.h"
+#include "remora/geometry/measures.h"
+#include "remora/linalg/kharmonic.h"
+#include "remora/mesh/primitives.h"
+#include "remora/multires/base_surface.h"
+
+namespace remora {
+namespace {
+
+/// A grid with needles, caps and exactly zero-area faces: odd rows pushed almost onto the row
+/// below and shifted sideways by 0.3 cells (corners near 180°: negative cotan weights), row 3
+/// exactly onto row 2 (zero-area faces).
+Mesh needle_grid() {
+  const int n = 20;
+  Mesh m = make_grid(n, n, 1.0, 1.0);
+  const double cell = 1.0 / n;
+  for (const VertexHandle v : m.vertices()) {
+    Vec3 p = m.point(v);
+    const int row = v.idx() / (n + 1), column = v.idx() % (n + 1);
+    if (row % 2 == 1 && row < n && column > 0 && column < n) {
+      p[1] -= row == 3 ? cell : 0.97 * cell;
+      if (row != 3) p[0] += 0.3 * cell;
+    }
+    m.set_point(v, p);
+  }
+  return m;
+}
+
+// Mollification fattens zero-area faces to a height of about sqrt(ε × length), so the mass may
+// exceed the surface area slightly (7e-5 on the needle grid).
+void expect_laplacian_invariants(const IntrinsicLaplacian& lap, double surface) {
+  const auto& w = lap.weights;
+  EXPECT_LT((w * Eigen::VectorXd::Ones(w.rows())).cwiseAbs().maxCoeff(), 1e-9 * w.cwiseAbs().sum());
+  EXPECT_LT((Eigen::SparseMatrix<double>(w.transpose()) - w).norm(), 1e-12 * w.norm());
+  for (Eigen::Index c = 0; c < w.outerSize(); ++c)
+    for (Eigen::SparseMatrix<double>::InnerIterator it(w, c); it; ++it) {
+      if (it.row() != it.col()) {
+        EXPECT_GE(it.value(), -1e-9) << it.row() << "," << it.col();
+      }
+    }
+  EXPECT_TRUE(lap.mass.allFinite());
+  EXPECT_GT(lap.mass.minCoeff(), 0.0);
+  EXPECT_NEAR(lap.mass.sum(), surface, 1e-3 * surface);
+}
+
+TEST(Intrinsic, AgreesWithCotanWeightsOnADelaunayMesh) {
+  const Mesh m = make_icosphere(3);
+  const IntrinsicLaplacian lap = intrinsic_delaunay_laplacian(m);
+  EXPECT_EQ(lap.flips, 0u);
+  EXPECT_EQ(lap.negative_before, 0u);
+  const Eigen::SparseMatrix<double> w = cotan_weights(m);
+  EXPECT_LT((lap.weights - w).norm(), 1e-4 * w.norm()); // mollification only
+  expect_laplacian_invariants(lap, surface_area(m));
+}
+
+TEST(Intrinsic, NeedlesAndZeroAreaFacesGetNonNegativeWeights) {
+  const Mesh m = needle_grid();
+  const Eigen::SparseMatrix<double> w = cotan_weights(m);
+  int negative = 0;
+  for (Eigen::Index c = 0; c < w.outerSize(); ++c)
+    for (Eigen::SparseMatrix<double>::InnerIterator it(w, c); it; ++it)
+      negative += it.row() != it.col() && it.value() < 0 ? 1 : 0;
+  ASSERT_GT(negative, 10);
+  const IntrinsicLaplacian lap = intrinsic_delaunay_laplacian(m);
+  EXPECT_GT(lap.flips, 10u);
+  EXPECT_GT(lap.epsilon, 0.0);
+  EXPECT_EQ(lap.negative_after, 0u);
+  expect_laplacian_invariants(lap, surface_area(m));
+}
+
+TEST(Intrinsic, RejectsBadOptions) {
+  IntrinsicOptions o;
+  o.mollify_factor = 0;
+  EXPECT_THROW(intrinsic_delaunay_laplacian(make_icosphere(1), o), InvalidArgument);
+}
+
+TEST(LowPass, KeepsConstantsAndDampsShortWavelengthsMore) {
+  Mesh m = make_grid(60, 60, 1.0, 1.0);
+  const Eigen::MatrixXd p = positions_matrix(m);
+  LowPassOptions options;
+  options.smoothing = 2.0;
+  LowPassFilter filter(m, options);
+  const auto n = p.rows();
+  Eigen::MatrixXd f(n, 3);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    f(i, 0) = 1.0;
+    f(i, 1) = std::cos(2 * M_PI * p(i, 0) / 0.5);  // long wavelength: 30 edges
+    f(i, 2) = std::cos(2 * M_PI * p(i, 0) / 0.05); // short: 3 edges
+  }
+  const Eigen::MatrixXd g = filter.apply(f);
+  EXPECT_LT((g.col(0).array() - 1.0).abs().maxCoeff(), 1e-8);
+  // Interior rows only (the boundary has the natural condition).
+  double long_ratio = 0, short_ratio = 0;
+  int count = 0;
+  for (Eigen::Index i = 0; i < n; ++i)
+    if (p(i, 0) > 0.2 && p(i, 0) < 0.8 && std::abs(f(i, 1)) > 0.9 && std::abs(f(i, 2)) > 0.9) {
+      long_ratio += g(i, 1) / f(i, 1);
+      short_ratio += g(i, 2) / f(i, 2);
+      ++count;
+    }
+  ASSERT_GT(count, 10);
+  long_ratio /= count;
+  short_ratio /= count;
+  // Continuum: 1 / (1 + (2πσ/λ)²), σ = 2 × the mean edge length (diagonals included, so
+  // 1.14 / 60): 0.815 for λ = 0.5, 0.04 for λ = 0.05.
+  const double sigma = filter.stats().sigma;
+  EXPECT_NEAR(sigma, 2.0 * (2.0 + std::sqrt(2.0)) / 3.0 / 60.0, 1e-3);
+  EXPECT_NEAR(long_ratio, 1.0 / (1.0 + std::pow(2 * M_PI * sigma / 0.5, 2)), 0.01);
+  EXPECT_LT(short_ratio, 0.15);
+  EXPECT_GT(filter.stats().sigma, 0.0);
+  // Zero smoothing is the identity.
+  options.smoothing = 0;
+  LowPassFilter identity(m, options);
+  EXPECT_EQ(identity.apply(f), f);
+  EXPECT_THROW(identity.apply(Eigen::MatrixXd::Zero(3, 3)), InvalidArgument);
+}
+
+} // namespace
+} // namespace remora
