@@ -26,9 +26,13 @@ build: deps
 	cmake --build $(BUILD) -j$(JOBS)
 
 # For now: the quality report of the bundled scan, then its area-equalizing remesh (paper §4).
+# The main job: an edit of the bundled bunny (lift the left ear and twist it), with the report.
 demo: build
 	$(BUILD)/bin/remora info $(DEMO_MESH)
 	$(BUILD)/bin/remora remesh $(DEMO_MESH) -o $(BUILD)/demo_remeshed.ply --report
+	$(BUILD)/bin/remora edit $(DEMO_MESH) -o $(BUILD)/demo_edited.ply \
+	    --support-sphere -0.03,0.15,0,0.05 --handle-sphere -0.03,0.17,0,0.015 \
+	    --translate 0,0.02,0 --rotate 0,1,0,20 --report
 
 # Release build with warnings as errors, the formatting check, then the unit tests again under
 # AddressSanitizer + UndefinedBehaviorSanitizer.
