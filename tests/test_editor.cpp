@@ -118,6 +118,33 @@ TEST(Editor, ARigidMotionOfAllConstraintsMovesEverythingRigidly) {
   // Moving only one of the two handles is not rigid.
   editor.set_transform(1, identity_transform());
   EXPECT_GT(max_row_distance(editor.positions(), expected.transpose()), 0.1 * diagonal);
+  // Offsets that do not turn with the base (displacement mode) break rotations: the reason for
+  // encoding details along the normal.
+  EditorOptions displacement;
+  displacement.details = DetailMode::Displacement;
+  Editor unrotated(mesh, displacement);
+  unrotated.set_region(all, {top, bottom});
+  unrotated.set_transform(0, motion);
+  unrotated.set_transform(1, motion);
+  EXPECT_GT(max_row_distance(unrotated.positions(), expected.transpose()), 1e-3 * diagonal);
+}
+
+TEST(Editor, MultigridAndTheDirectSolverGiveTheSameEdit) {
+  const Mesh mesh = bumpy_sphere(4);
+  const auto support = sphere_ids(mesh, Vec3(0, 0, 1), 1.0);
+  const auto handle = sphere_ids(mesh, Vec3(0, 0, 1), 0.3);
+  Eigen::MatrixXd results[2];
+  for (int i = 0; i < 2; ++i) {
+    EditorOptions options;
+    if (i == 1) options.solver.name = "multigrid";
+    Editor editor(mesh, options);
+    editor.set_region(support, {handle});
+    editor.set_transform(
+        0, compose(translation({0.1, 0, 0.3}), rotation({1, 0, 0}, 0.4, editor.handle_center(0))));
+    results[i] = editor.positions();
+    EXPECT_EQ(editor.report().solver, i == 0 ? default_solver_name() : "multigrid");
+  }
+  EXPECT_LT(max_row_distance(results[0], results[1]), 1e-6 * bounding_box_diagonal(mesh));
 }
 
 // Detail retention: the spread of (result − its low-pass) over that of (input − its low-pass),
