@@ -7,8 +7,10 @@ JOBS       ?= $(shell nproc)
 CMAKE_FLAGS ?=
 DEMO_MESH  ?= data/bunny.ply
 BENCH_ARGS ?=
+PORT       ?= 8080
 
-.PHONY: all deps deps-bench build demo test test-release test-asan bench format format-check clean
+PHONY_EXTRA = deps-web serve
+.PHONY: all deps deps-bench $(PHONY_EXTRA) build demo test test-release test-asan bench format format-check clean
 
 all: build
 
@@ -18,6 +20,9 @@ deps:
 deps-bench:
 	@scripts/bootstrap.sh --bench
 
+deps-web:
+	@scripts/bootstrap.sh --web
+
 # REMORA_WITH_CGAL=OFF is explicit so that a build folder `make bench` configured goes back to
 # the CGAL-free default.
 build: deps
@@ -25,18 +30,24 @@ build: deps
 	  $(CMAKE_FLAGS)
 	cmake --build $(BUILD) -j$(JOBS)
 
-# For now: the quality report of the bundled scan, then its area-equalizing remesh (paper §4).
-# The main job: an edit of the bundled bunny (lift the left ear and twist it), with the report.
+# The quality report of the bundled scan, its area-equalizing remesh (paper §4), one edit from
+# the command line (lift the left ear and twist it), then the editor in the browser: open the
+# URL it prints (Ctrl+C stops the server).
 demo: build
 	$(BUILD)/bin/remora info $(DEMO_MESH)
 	$(BUILD)/bin/remora remesh $(DEMO_MESH) -o $(BUILD)/demo_remeshed.ply --report
 	$(BUILD)/bin/remora edit $(DEMO_MESH) -o $(BUILD)/demo_edited.ply \
 	    --support-sphere -0.03,0.15,0,0.05 --handle-sphere -0.03,0.17,0,0.015 \
 	    --translate 0,0.02,0 --rotate 0,1,0,20 --report
+	$(BUILD)/bin/remora serve $(DEMO_MESH) --port $(PORT)
+
+# The browser editor alone.
+serve: build
+	$(BUILD)/bin/remora serve $(DEMO_MESH) --port $(PORT)
 
 # Release build with warnings as errors, the formatting check, then the unit tests again under
 # AddressSanitizer + UndefinedBehaviorSanitizer.
-test: deps format-check test-release test-asan
+test: deps-web format-check test-release test-asan
 
 # ctest runs $(JOBS) test processes at once; OpenMP threads that spin while waiting and OpenBLAS's
 # own threads then fight over the cores (the solver tests took 15-36 s instead of 0.2-2 s), so
@@ -48,7 +59,7 @@ test-release: build
 
 test-asan: deps
 	cmake -S . -B $(ASAN_BUILD) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DREMORA_WERROR=ON \
-	  -DREMORA_SANITIZE=ON -DREMORA_BUILD_BENCH=OFF $(CMAKE_FLAGS)
+	  -DREMORA_SANITIZE=ON -DREMORA_BUILD_BENCH=OFF -DREMORA_BUILD_WEB=OFF $(CMAKE_FLAGS)
 	cmake --build $(ASAN_BUILD) -j$(JOBS)
 	cd $(ASAN_BUILD) && $(TEST_ENV) REMORA_SANITIZED=1 ASAN_OPTIONS=detect_leaks=1 \
 	  UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 ctest --output-on-failure -j$(JOBS)

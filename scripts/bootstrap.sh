@@ -5,14 +5,20 @@
 #   scripts/bootstrap.sh           the packages of the default build (make build/test/demo)
 #   scripts/bootstrap.sh --bench   those plus the benchmark-only ones (make bench): libcgal-dev,
 #                                  for the remeshing race against CGAL (GPL; never in the library)
+#   scripts/bootstrap.sh --web     those plus Debian's chromium, which the browser editor's
+#                                  end-to-end test drives (make test)
+# Node.js and npm (for three.js and playwright-core, scripts/build_web.sh) are installed from
+# Debian when the machine has no `npm` command.
 set -euo pipefail
 
 bench=0
+web=0
 for arg in "$@"; do
   case "$arg" in
     --bench) bench=1 ;;
+    --web) web=1 ;;
     *)
-      echo "bootstrap: unknown argument '$arg' (usage: scripts/bootstrap.sh [--bench])" >&2
+      echo "bootstrap: unknown argument '$arg' (usage: scripts/bootstrap.sh [--bench] [--web])" >&2
       exit 2
       ;;
   esac
@@ -28,6 +34,9 @@ packages=(
 if [ "$bench" -eq 1 ]; then
   packages+=(libcgal-dev)
 fi
+if [ "$web" -eq 1 ]; then
+  packages+=(chromium)
+fi
 
 missing=()
 for p in "${packages[@]}"; do
@@ -35,6 +44,9 @@ for p in "${packages[@]}"; do
     missing+=("$p")
   fi
 done
+if ! command -v npm >/dev/null; then
+  missing+=(nodejs npm)
+fi
 
 if [ ${#missing[@]} -eq 0 ]; then
   exit 0

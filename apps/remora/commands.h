@@ -11,7 +11,10 @@ void add_convert_command(CLI::App& app);
 void add_remesh_command(CLI::App& app);
 void add_bench_command(CLI::App& app);
 void add_edit_command(CLI::App& app);
+void add_serve_command(CLI::App& app);
 /// `remora bench edit`, a subcommand of `remora bench`.
 void add_bench_edit_command(CLI::App& bench);
+/// `remora bench serve`, a subcommand of `remora bench`.
+void add_bench_serve_command(CLI::App& bench);
 
 } // namespace remora::cli

@@ -22,6 +22,7 @@ int main(int argc, char** argv) {
   remora::cli::add_convert_command(app);
   remora::cli::add_remesh_command(app);
   remora::cli::add_edit_command(app);
+  remora::cli::add_serve_command(app);
   remora::cli::add_bench_command(app);
 
   // Logs go to stderr so that stdout carries only the command's output (e.g. --json).

@@ -484,6 +484,18 @@ int Editor::handle_count() const {
   return impl_->region ? impl_->region->handles : 0;
 }
 
+const std::vector<int>& Editor::movable_vertices() const {
+  static const std::vector<int> none;
+  return impl_->region ? impl_->region->encoded : none;
+}
+
+void Editor::set_system(const KHarmonicOptions& system) {
+  EditorOptions o = impl_->options;
+  o.system = system;
+  check_options(o);
+  impl_->options.system = system;
+}
+
 Eigen::Vector3d Editor::handle_center(int handle) const {
   const RegionState& r = impl_->state();
   if (handle < 0 || handle >= r.handles)

@@ -131,6 +131,12 @@ public:
   void set_region(const std::vector<int>& support, const std::vector<std::vector<int>>& handles);
 
   int handle_count() const;
+  /// The vertices of O that can move under the current region (the support, handles included),
+  /// in increasing order; empty before set_region().
+  const std::vector<int>& movable_vertices() const;
+  /// Changes k and the area weights for the next set_region(). Throws InvalidArgument for a k
+  /// other than 1, 2, 3, or weights the configured solver cannot take.
+  void set_system(const KHarmonicOptions& system);
   /// The centroid of handle j's vertices on O (the default center of rotations and scalings).
   Eigen::Vector3d handle_center(int handle) const;
 

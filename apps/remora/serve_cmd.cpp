@@ -1,0 +1,105 @@
+// `remora serve`: the browser editor. Binds the API of apps/server/api.h and the page's files to
+// cpp-httplib, on loopback unless told otherwise, and prints the URL.
+#include <csignal>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <sstream>
+
+#include <fmt/format.h>
+
+#include "api.h"
+#include "commands.h"
+#include "remora/common/error.h"
+#include "session.h"
+
+// Last: httplib.h pulls in <resolv.h>, whose `_res` macro breaks Eigen's headers if they follow.
+#include <httplib.h> // NOLINT(llvm-include-order)
+
+namespace remora::cli {
+
+namespace {
+
+httplib::Server* running = nullptr;
+
+void stop_on_signal(int) {
+  if (running) running->stop();
+}
+
+} // namespace
+
+void add_serve_command(CLI::App& app) {
+  auto* cmd = app.add_subcommand("serve", "The editor in the browser: serves the page and its API");
+  struct Args {
+    std::string mesh, host = "127.0.0.1", web_root = REMORA_WEB_ROOT;
+    int port = 8080, threads = 0;
+    double max_upload_mb = 256;
+  };
+  auto a = std::make_shared<Args>();
+  cmd->add_option("mesh", a->mesh, "Mesh to load at start (.obj .off .ply .stl)");
+  cmd->add_option("--host", a->host, "Address to bind (default 127.0.0.1: this machine only)");
+  cmd->add_option("--port", a->port, "Port (default 8080; 0 picks a free one)")
+      ->check(CLI::Range(0, 65535));
+  cmd->add_option("--web-root", a->web_root, "Folder of the page's files (default: the build's)");
+  cmd->add_option("--max-upload-mb", a->max_upload_mb, "Largest mesh upload in MB (default 256)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--threads", a->threads, "Editor threads (default: all)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->callback([a] {
+    if (!std::filesystem::exists(std::filesystem::path(a->web_root) / "index.html"))
+      throw InvalidArgument(fmt::format(
+          "the page's files are not in {} (index.html missing): build them with `make web`, or "
+          "give --web-root",
+          a->web_root));
+    server::SessionOptions options;
+    options.threads = a->threads;
+    server::Session session(options);
+    server::ApiLimits limits;
+    limits.max_upload_bytes = static_cast<std::size_t>(a->max_upload_mb * 1024 * 1024);
+    if (!a->mesh.empty()) {
+      std::ifstream in(a->mesh, std::ios::binary);
+      if (!in) throw IoError(a->mesh, "cannot open the file");
+      std::ostringstream bytes;
+      bytes << in.rdbuf();
+      session.start_load(bytes.str(), std::filesystem::path(a->mesh).filename().string());
+    }
+    httplib::Server http;
+    http.set_payload_max_length(limits.max_upload_bytes + 1);
+    const std::string root = a->web_root;
+    auto adapt = [&session, &limits, root](const httplib::Request& req, httplib::Response& res) {
+      server::HttpRequest q{req.method, req.path, {}, req.body};
+      for (const auto& [key, value] : req.params) q.query[key] = value;
+      server::HttpResponse r;
+      if (req.path.rfind("/api/", 0) == 0)
+        r = server::handle_api(session, q, limits);
+      else if (req.method == "GET")
+        r = server::serve_static(root, req.path);
+      else
+        r = {405, "application/json", R"({"error": "only GET serves files"})", {}};
+      res.status = r.status;
+      for (const auto& [key, value] : r.headers) res.set_header(key, value);
+      res.set_header("Cache-Control", "no-store");
+      res.set_content(r.body, r.content_type.c_str());
+    };
+    http.Get(".*", adapt);
+    http.Post(".*", adapt);
+    int port = a->port;
+    if (port == 0) {
+      port = http.bind_to_any_port(a->host.c_str());
+    } else if (!http.bind_to_port(a->host.c_str(), port)) {
+      throw IoError(fmt::format("{}:{}", a->host, port),
+                    "cannot listen there (in use? try --port 0 for a free port)");
+    }
+    if (port < 0) throw IoError(a->host, "cannot listen on any port");
+    std::cout << fmt::format("remora: editing at http://{}:{}/  (Ctrl+C stops)", a->host, port)
+              << std::endl;
+    running = &http;
+    std::signal(SIGINT, stop_on_signal);
+    std::signal(SIGTERM, stop_on_signal);
+    http.listen_after_bind();
+    running = nullptr;
+    session.wait();
+  });
+}
+
+} // namespace remora::cli

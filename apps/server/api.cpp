@@ -1,0 +1,219 @@
+#include "api.h"
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+namespace remora::server {
+
+namespace {
+
+using nlohmann::json;
+
+HttpResponse json_response(int status, const json& body) {
+  HttpResponse r;
+  r.status = status;
+  r.body = body.dump();
+  return r;
+}
+
+HttpResponse error_response(int status, const std::string& message) {
+  return json_response(status, {{"error", message}});
+}
+
+template <class T>
+HttpResponse binary_response(const std::vector<T>& data) {
+  HttpResponse r;
+  r.content_type = "application/octet-stream";
+  r.body.resize(data.size() * sizeof(T));
+  if (!data.empty()) std::memcpy(r.body.data(), data.data(), r.body.size());
+  return r;
+}
+
+/// A 400 with a message: a request the client can fix.
+class BadRequest : public Error {
+public:
+  using Error::Error;
+};
+
+json parse_json(const HttpRequest& request, const ApiLimits& limits) {
+  if (request.body.size() > limits.max_json_bytes)
+    throw BadRequest(fmt::format("the JSON body has {} bytes; the limit is {}", request.body.size(),
+                                 limits.max_json_bytes));
+  try {
+    return json::parse(request.body);
+  } catch (const json::parse_error& e) {
+    throw BadRequest(fmt::format("the body is not valid JSON: {}", e.what()));
+  }
+}
+
+std::vector<int> ids(const json& j, const std::string& path) {
+  if (!j.is_array()) throw BadRequest(path + ": expected an array of vertex ids");
+  std::vector<int> out;
+  out.reserve(j.size());
+  for (std::size_t i = 0; i < j.size(); ++i) {
+    if (!j[i].is_number_integer() || j[i].get<long long>() < 0 ||
+        j[i].get<long long>() > 2147483647LL)
+      throw BadRequest(fmt::format("{}[{}]: expected a vertex id (an integer >= 0)", path, i));
+    out.push_back(j[i].get<int>());
+  }
+  return out;
+}
+
+void only_keys(const json& j, std::initializer_list<const char*> keys) {
+  if (!j.is_object()) throw BadRequest("expected a JSON object");
+  for (const auto& item : j.items()) {
+    bool known = false;
+    for (const char* k : keys) known = known || item.key() == k;
+    if (!known) throw BadRequest(fmt::format("unknown key '{}'", item.key()));
+  }
+}
+
+HttpResponse region(Session& session, const HttpRequest& request, const ApiLimits& limits) {
+  const json j = parse_json(request, limits);
+  only_keys(j, {"support", "handles", "k"});
+  if (!j.contains("support") || !j.contains("handles"))
+    throw BadRequest("expected {\"support\": [ids], \"handles\": [[ids], ...], \"k\": 1|2|3}");
+  std::vector<int> support = ids(j.at("support"), "support");
+  const json& hs = j.at("handles");
+  if (!hs.is_array()) throw BadRequest("handles: expected an array of arrays of vertex ids");
+  std::vector<std::vector<int>> handles;
+  for (std::size_t i = 0; i < hs.size(); ++i)
+    handles.push_back(ids(hs[i], fmt::format("handles[{}]", i)));
+  int k = 2;
+  if (j.contains("k")) {
+    if (!j.at("k").is_number_integer()) throw BadRequest("k: expected 1, 2 or 3");
+    k = j.at("k").get<int>();
+  }
+  if (support.empty()) throw BadRequest("the support is empty: paint at least one vertex");
+  if (handles.empty()) throw BadRequest("no handle: paint a handle inside the support");
+  session.start_region(std::move(support), std::move(handles), k);
+  return json_response(202, session.status());
+}
+
+HttpResponse transform(Session& session, const HttpRequest& request, const ApiLimits& limits) {
+  const json j = parse_json(request, limits);
+  only_keys(j, {"handle", "matrix"});
+  if (!j.contains("handle") || !j.at("handle").is_number_integer())
+    throw BadRequest("handle: expected a handle index");
+  const json& m = j.contains("matrix") ? j.at("matrix") : json();
+  if (!m.is_array() || m.size() != 12)
+    throw BadRequest("matrix: expected 12 numbers, the rows of the 3x4 affine map [M | t]");
+  Transform t;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 4; ++c) {
+      const json& x = m[static_cast<std::size_t>(4 * r + c)];
+      if (!x.is_number() || !std::isfinite(x.get<double>()))
+        throw BadRequest(fmt::format("matrix[{}]: expected a finite number", 4 * r + c));
+      t(r, c) = x.get<double>();
+    }
+  double frame_ms = 0;
+  HttpResponse r = binary_response(session.set_transform(j.at("handle").get<int>(), t, &frame_ms));
+  r.headers["X-Frame-Ms"] = fmt::format("{:.3f}", frame_ms);
+  return r;
+}
+
+HttpResponse dispatch(Session& session, const HttpRequest& q, const ApiLimits& limits) {
+  const std::string& p = q.path;
+  const bool get = q.method == "GET", post = q.method == "POST";
+  auto need = [&](bool ok) {
+    if (!ok) throw std::invalid_argument("method");
+  };
+  if (p == "/api/status") return need(get), json_response(200, session.status());
+  if (p == "/api/load") {
+    need(post);
+    const auto name = q.query.find("name");
+    if (name == q.query.end() || name->second.empty())
+      throw BadRequest("give the file name as ?name=mesh.ply (its extension names the format)");
+    if (q.body.empty()) throw BadRequest("the upload is empty");
+    if (q.body.size() > limits.max_upload_bytes)
+      return error_response(413, fmt::format("the upload has {} bytes; the limit is {}",
+                                             q.body.size(), limits.max_upload_bytes));
+    session.start_load(q.body, name->second);
+    return json_response(202, session.status());
+  }
+  if (p == "/api/mesh/positions") return need(get), binary_response(session.positions());
+  if (p == "/api/mesh/indices") return need(get), binary_response(session.indices());
+  if (p == "/api/movable") return need(get), binary_response(session.movable_vertices());
+  if (p == "/api/base/positions") return need(get), binary_response(session.base_positions());
+  if (p == "/api/base/indices") return need(get), binary_response(session.base_indices());
+  if (p == "/api/base/areas") return need(get), binary_response(session.base_areas());
+  if (p == "/api/region" && get) return json_response(200, session.region());
+  if (p == "/api/region") return need(post), region(session, q, limits);
+  if (p == "/api/transform") return need(post), transform(session, q, limits);
+  if (p == "/api/commit") return need(post), session.commit(), json_response(200, session.status());
+  if (p == "/api/undo" || p == "/api/redo") {
+    need(post);
+    const bool done = p == "/api/undo" ? session.undo() : session.redo();
+    json s = session.status();
+    s["changed"] = done;
+    return json_response(200, s);
+  }
+  if (p == "/api/export") {
+    need(get);
+    const auto f = q.query.find("format");
+    const std::string format = f == q.query.end() ? "ply" : f->second;
+    HttpResponse r;
+    r.content_type = "application/octet-stream";
+    r.body = session.export_mesh(format);
+    r.headers["Content-Disposition"] = fmt::format("attachment; filename=\"edited.{}\"", format);
+    return r;
+  }
+  return error_response(404, fmt::format("no endpoint {} (see docs/server.md)", p));
+}
+
+} // namespace
+
+HttpResponse handle_api(Session& session, const HttpRequest& request, const ApiLimits& limits) {
+  try {
+    return dispatch(session, request, limits);
+  } catch (const std::invalid_argument&) {
+    return error_response(405, fmt::format("{} does not take {}", request.path, request.method));
+  } catch (const BadRequest& e) {
+    return error_response(400, e.what());
+  } catch (const Busy& e) {
+    return error_response(409, e.what());
+  } catch (const InvalidArgument& e) {
+    return error_response(400, e.what());
+  } catch (const IoError& e) {
+    return error_response(400, e.what());
+  } catch (const NumericalError& e) {
+    return error_response(422, e.what());
+  } catch (const std::bad_alloc&) {
+    return error_response(413, "out of memory: the request is too large for this machine");
+  } catch (const std::exception& e) {
+    return error_response(500, fmt::format("internal error: {}", e.what()));
+  }
+}
+
+HttpResponse serve_static(const std::string& root, const std::string& path) {
+  namespace fs = std::filesystem;
+  const std::string rel = path == "/" || path.empty() ? "index.html" : path.substr(1);
+  if (rel.find("..") != std::string::npos || rel.find('\\') != std::string::npos ||
+      (!rel.empty() && rel[0] == '/'))
+    return error_response(404, "not found");
+  const fs::path file = fs::path(root) / rel;
+  std::error_code ec;
+  if (!fs::is_regular_file(file, ec)) return error_response(404, "not found: " + path);
+  std::ifstream in(file, std::ios::binary);
+  std::ostringstream bytes;
+  bytes << in.rdbuf();
+  HttpResponse r;
+  r.body = bytes.str();
+  const std::string ext = file.extension().string();
+  r.content_type = ext == ".html"  ? "text/html; charset=utf-8"
+                   : ext == ".js"  ? "text/javascript; charset=utf-8"
+                   : ext == ".mjs" ? "text/javascript; charset=utf-8"
+                   : ext == ".css" ? "text/css; charset=utf-8"
+                   : ext == ".png" ? "image/png"
+                   : ext == ".ply" ? "application/octet-stream"
+                                   : "application/octet-stream";
+  return r;
+}
+
+} // namespace remora::server

@@ -1,0 +1,420 @@
+#include "session.h"
+
+#include <atomic>
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <unistd.h>
+
+#include <fmt/format.h>
+
+#include "remora/geometry/measures.h"
+#include "remora/geometry/quality.h"
+#include "remora/linalg/kharmonic.h"
+#include "remora/mesh/io.h"
+
+namespace remora::server {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double ms_since(Clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+}
+
+struct RegionKey {
+  std::vector<int> support;
+  std::vector<std::vector<int>> handles;
+  int k = 2;
+  bool operator==(const RegionKey&) const = default;
+};
+
+/// An editor and the region it currently has.
+struct EditorBox {
+  explicit EditorBox(Editor e) : editor(std::move(e)) {}
+  Editor editor;
+  std::optional<RegionKey> region;
+  double preprocess_ms = 0.0;
+};
+
+struct Snapshot {
+  std::shared_ptr<EditorBox> box;
+  std::optional<RegionKey> region;
+  std::vector<Transform> transforms;
+};
+
+bool is_identity(const std::vector<Transform>& transforms) {
+  for (const Transform& t : transforms)
+    if (t != identity_transform()) return false;
+  return true;
+}
+
+} // namespace
+
+struct Session::Impl {
+  SessionOptions options;
+  mutable std::mutex mutex;
+  std::condition_variable idle;
+  std::thread worker;
+  bool busy = false;
+  std::string job;   // what the worker does ("load", "region")
+  std::string phase; // its current phase
+  int step = 0, steps = 0;
+  std::string error;                 // the last job's failure, if any
+  std::string name;                  // the mesh's file name
+  std::shared_ptr<EditorBox> box;    // current editor
+  std::optional<RegionKey> region;   // current region
+  std::vector<Transform> transforms; // live transforms
+  std::vector<Snapshot> history;
+  std::size_t cursor = 0; // history[cursor] is the applied snapshot
+  double last_frame_ms = 0.0;
+
+  void require_ready() const {
+    if (busy) throw Busy(fmt::format("the session is busy ({}: {})", job, phase));
+    if (!box) throw Busy("no mesh is loaded yet: load one first");
+  }
+  void require_region() const {
+    require_ready();
+    if (!region) throw Busy("no region yet: paint a support and a handle first");
+  }
+  void push_snapshot() {
+    if (!history.empty()) history.resize(cursor + 1); // drop the redo branch
+    history.push_back({box, region, transforms});
+    if (history.size() > options.max_history) history.erase(history.begin());
+    cursor = history.size() - 1;
+  }
+  /// Re-applies a snapshot (undo/redo): same editor, region and transforms, same positions.
+  void apply(const Snapshot& s) {
+    box = s.box;
+    region = s.region;
+    transforms = s.transforms;
+    if (region && box->region != region) {
+      box->editor.set_system({region->k, box->editor.options().system.areas});
+      box->editor.set_region(region->support, region->handles);
+      box->region = region;
+    }
+    for (std::size_t j = 0; j < transforms.size(); ++j)
+      box->editor.set_transform(static_cast<int>(j), transforms[j]);
+  }
+  void run(std::string what, std::function<void()> work) {
+    if (busy) throw Busy(fmt::format("the session is busy ({}: {})", job, phase));
+    if (worker.joinable()) worker.join();
+    busy = true;
+    job = std::move(what);
+    phase = "starting";
+    step = steps = 0;
+    error.clear();
+    worker = std::thread([this, work = std::move(work)] {
+      try {
+        work();
+      } catch (const std::exception& e) {
+        std::lock_guard lock(mutex);
+        error = e.what();
+      }
+      std::lock_guard lock(mutex);
+      busy = false;
+      phase.clear();
+      idle.notify_all();
+    });
+  }
+  EditorOptions editor_options() {
+    EditorOptions o = options.editor;
+    o.threads = options.threads;
+    o.progress = [this](std::string_view p, int s, int n) {
+      std::lock_guard lock(mutex);
+      phase = std::string(p);
+      step = s;
+      steps = n;
+    };
+    return o;
+  }
+};
+
+Session::Session(SessionOptions options) : impl_(std::make_unique<Impl>()) {
+  impl_->options = std::move(options);
+}
+
+Session::~Session() {
+  if (impl_->worker.joinable()) impl_->worker.join();
+}
+
+void Session::wait() {
+  std::unique_lock lock(impl_->mutex);
+  impl_->idle.wait(lock, [&] { return !impl_->busy; });
+}
+
+void Session::start_load(std::string bytes, std::string name) {
+  std::lock_guard lock(impl_->mutex);
+  const MeshFormat format = format_from_path(name); // IoError for an unknown extension, now
+  impl_->run("load", [this, bytes = std::move(bytes), name, format] {
+    Impl& m = *impl_;
+    const auto t0 = Clock::now();
+    {
+      std::lock_guard guard(m.mutex);
+      m.phase = "reading";
+    }
+    LoadResult loaded = read_mesh_from_memory(bytes, format, name);
+    auto box = std::make_shared<EditorBox>(Editor(std::move(loaded.mesh), m.editor_options()));
+    box->preprocess_ms = ms_since(t0);
+    std::lock_guard guard(m.mutex);
+    m.box = box;
+    m.name = name;
+    m.region.reset();
+    m.transforms.clear();
+    m.history.clear();
+    m.push_snapshot();
+  });
+}
+
+void Session::start_region(std::vector<int> support, std::vector<std::vector<int>> handles, int k) {
+  std::lock_guard lock(impl_->mutex);
+  Impl& m = *impl_;
+  m.require_ready();
+  if (k < 1 || k > 3) throw InvalidArgument(fmt::format("k = {} is not 1, 2 or 3", k));
+  const auto n = static_cast<int>(m.box->editor.input().n_vertices());
+  for (const int v : support)
+    if (v < 0 || v >= n)
+      throw InvalidArgument(fmt::format("support vertex {} is out of range (the mesh has {} "
+                                        "vertices)",
+                                        v, n));
+  for (const auto& h : handles)
+    for (const int v : h)
+      if (v < 0 || v >= n)
+        throw InvalidArgument(fmt::format("handle vertex {} is out of range (the mesh has {} "
+                                          "vertices)",
+                                          v, n));
+  RegionKey key{std::move(support), std::move(handles), k};
+  const bool bake = !is_identity(m.transforms);
+  std::shared_ptr<EditorBox> current = m.box;
+  m.run("region", [this, key = std::move(key), bake, current] {
+    Impl& s = *impl_;
+    std::shared_ptr<EditorBox> box = current;
+    if (bake) {
+      // The edited shape becomes the next input: a new base, remeshed.
+      const auto t0 = Clock::now();
+      Mesh result = current->editor.result();
+      box = std::make_shared<EditorBox>(Editor(std::move(result), s.editor_options()));
+      box->preprocess_ms = ms_since(t0);
+    }
+    {
+      std::lock_guard guard(s.mutex);
+      s.phase = "set_region";
+    }
+    // On a copy of the key: a failure leaves the session as it was.
+    box->editor.set_system({key.k, box->editor.options().system.areas});
+    box->editor.set_region(key.support, key.handles);
+    box->region = key;
+    std::lock_guard guard(s.mutex);
+    s.box = box;
+    s.region = key;
+    s.transforms.assign(key.handles.size(), identity_transform());
+    s.push_snapshot();
+  });
+}
+
+std::vector<float> Session::set_transform(int handle, const Transform& transform,
+                                          double* frame_ms) {
+  std::lock_guard lock(impl_->mutex);
+  Impl& m = *impl_;
+  m.require_region();
+  m.box->editor.set_transform(handle, transform); // validates
+  m.transforms[static_cast<std::size_t>(handle)] = transform;
+  const auto t0 = Clock::now();
+  const Eigen::MatrixXd& p = m.box->editor.positions();
+  const std::vector<int>& movable = m.box->editor.movable_vertices();
+  std::vector<float> out(3 * movable.size());
+  for (std::size_t i = 0; i < movable.size(); ++i)
+    for (int c = 0; c < 3; ++c)
+      out[3 * i + static_cast<std::size_t>(c)] = static_cast<float>(p(movable[i], c));
+  m.last_frame_ms = ms_since(t0);
+  if (frame_ms) *frame_ms = m.last_frame_ms;
+  return out;
+}
+
+void Session::commit() {
+  std::lock_guard lock(impl_->mutex);
+  Impl& m = *impl_;
+  m.require_region();
+  const Snapshot& s = m.history[m.cursor];
+  if (s.box == m.box && s.region == m.region && s.transforms == m.transforms) return;
+  m.push_snapshot();
+}
+
+bool Session::undo() {
+  std::lock_guard lock(impl_->mutex);
+  Impl& m = *impl_;
+  m.require_ready();
+  if (m.cursor == 0) return false;
+  m.apply(m.history[--m.cursor]);
+  return true;
+}
+
+bool Session::redo() {
+  std::lock_guard lock(impl_->mutex);
+  Impl& m = *impl_;
+  m.require_ready();
+  if (m.cursor + 1 >= m.history.size()) return false;
+  m.apply(m.history[++m.cursor]);
+  return true;
+}
+
+nlohmann::json Session::status() const {
+  std::lock_guard lock(impl_->mutex);
+  const Impl& m = *impl_;
+  nlohmann::json j;
+  j["state"] = m.busy ? "busy" : (m.box ? "ready" : "empty");
+  if (m.busy)
+    j["progress"] = {{"job", m.job}, {"phase", m.phase}, {"step", m.step}, {"steps", m.steps}};
+  if (!m.error.empty()) j["error"] = m.error;
+  j["undo"] = !m.busy && m.cursor > 0;
+  j["redo"] = !m.busy && m.cursor + 1 < m.history.size();
+  // While the worker runs it may be writing the editor: report nothing from it.
+  if (!m.box || m.busy) return j;
+  const EditReport& r = m.box->editor.report();
+  j["mesh"] = {{"name", m.name}, {"vertices", r.input_vertices}, {"faces", r.input_faces}};
+  j["base"] = {{"vertices", r.base_vertices},
+               {"faces", r.base_faces},
+               {"preprocess_ms", m.box->preprocess_ms},
+               {"area_rel_mad", r.base_quality.mixed_area.rel_mad},
+               {"min_angle_deg", r.base_quality.angles.min_deg},
+               {"symmetry_defect", r.base_symmetry_defect}};
+  j["k"] = m.box->editor.options().system.k;
+  j["frame_ms"] = m.last_frame_ms;
+  if (m.region) {
+    j["region"] = {{"support", m.region->support.size()},
+                   {"handles", m.region->handles.size()},
+                   {"k", m.region->k},
+                   {"free_base_vertices", r.free_base_vertices},
+                   {"set_region_ms",
+                    r.milliseconds.count("set_region") ? r.milliseconds.at("set_region") : 0.0},
+                   {"movable", m.box->editor.movable_vertices().size()}};
+    nlohmann::json transforms = nlohmann::json::array();
+    for (const Transform& t : m.transforms) {
+      std::vector<double> row_major;
+      for (int r_ = 0; r_ < 3; ++r_)
+        for (int c = 0; c < 4; ++c) row_major.push_back(t(r_, c));
+      transforms.push_back(row_major);
+    }
+    j["transforms"] = transforms;
+  }
+  return j;
+}
+
+nlohmann::json Session::region() const {
+  std::lock_guard lock(impl_->mutex);
+  const Impl& m = *impl_;
+  m.require_ready();
+  if (!m.region) return nullptr;
+  return {{"support", m.region->support}, {"handles", m.region->handles}, {"k", m.region->k}};
+}
+
+std::vector<float> Session::positions() const {
+  std::lock_guard lock(impl_->mutex);
+  const Impl& m = *impl_;
+  m.require_ready();
+  Editor& editor = m.box->editor;
+  const Mesh& input = editor.input();
+  std::vector<float> out(3 * input.n_vertices());
+  if (m.region) {
+    const Eigen::MatrixXd& p = editor.positions();
+    for (Eigen::Index v = 0; v < p.rows(); ++v)
+      for (int c = 0; c < 3; ++c)
+        out[3 * static_cast<std::size_t>(v) + static_cast<std::size_t>(c)] =
+            static_cast<float>(p(v, c));
+  } else {
+    for (const VertexHandle v : input.vertices())
+      for (int c = 0; c < 3; ++c)
+        out[3 * static_cast<std::size_t>(v.idx()) + static_cast<std::size_t>(c)] =
+            static_cast<float>(input.point(v)[c]);
+  }
+  return out;
+}
+
+namespace {
+std::vector<std::uint32_t> face_indices(const Mesh& mesh) {
+  std::vector<std::uint32_t> out;
+  out.reserve(3 * mesh.n_faces());
+  for (const FaceHandle f : mesh.faces())
+    for (const VertexHandle v : mesh.fv_range(f))
+      out.push_back(static_cast<std::uint32_t>(v.idx()));
+  return out;
+}
+} // namespace
+
+std::vector<std::uint32_t> Session::indices() const {
+  std::lock_guard lock(impl_->mutex);
+  impl_->require_ready();
+  return face_indices(impl_->box->editor.input());
+}
+
+std::vector<std::uint32_t> Session::movable_vertices() const {
+  std::lock_guard lock(impl_->mutex);
+  impl_->require_ready();
+  const auto& movable = impl_->box->editor.movable_vertices();
+  return {movable.begin(), movable.end()};
+}
+
+std::vector<float> Session::base_positions() const {
+  std::lock_guard lock(impl_->mutex);
+  const Impl& m = *impl_;
+  m.require_ready();
+  std::vector<float> out;
+  if (m.region) {
+    const Eigen::MatrixXd& p = m.box->editor.base_positions();
+    out.resize(3 * static_cast<std::size_t>(p.rows()));
+    for (Eigen::Index v = 0; v < p.rows(); ++v)
+      for (int c = 0; c < 3; ++c)
+        out[3 * static_cast<std::size_t>(v) + static_cast<std::size_t>(c)] =
+            static_cast<float>(p(v, c));
+    return out;
+  }
+  const Mesh& base = m.box->editor.base();
+  out.resize(3 * base.n_vertices());
+  for (const VertexHandle v : base.vertices())
+    for (int c = 0; c < 3; ++c)
+      out[3 * static_cast<std::size_t>(v.idx()) + static_cast<std::size_t>(c)] =
+          static_cast<float>(base.point(v)[c]);
+  return out;
+}
+
+std::vector<std::uint32_t> Session::base_indices() const {
+  std::lock_guard lock(impl_->mutex);
+  impl_->require_ready();
+  return face_indices(impl_->box->editor.base());
+}
+
+std::vector<float> Session::base_areas() const {
+  std::lock_guard lock(impl_->mutex);
+  impl_->require_ready();
+  const Eigen::VectorXd a = vertex_areas_mixed(impl_->box->editor.base());
+  const double mean = a.size() > 0 ? a.mean() : 1.0;
+  std::vector<float> out(static_cast<std::size_t>(a.size()));
+  for (Eigen::Index i = 0; i < a.size(); ++i)
+    out[static_cast<std::size_t>(i)] = static_cast<float>(a[i] / mean);
+  return out;
+}
+
+std::string Session::export_mesh(const std::string& format) const {
+  if (format != "obj" && format != "ply" && format != "stl")
+    throw InvalidArgument(fmt::format("unknown export format '{}': use obj, ply or stl", format));
+  Mesh result;
+  {
+    std::lock_guard lock(impl_->mutex);
+    impl_->require_ready();
+    result = impl_->region ? impl_->box->editor.result() : impl_->box->editor.input();
+  }
+  // write_mesh() writes files atomically; a private temporary file gives the bytes.
+  const auto path = std::filesystem::temp_directory_path() /
+                    fmt::format("remora_export_{}_{}.{}", ::getpid(),
+                                std::hash<std::thread::id>{}(std::this_thread::get_id()), format);
+  write_mesh(path.string(), result);
+  std::ifstream in(path, std::ios::binary);
+  std::ostringstream bytes;
+  bytes << in.rdbuf();
+  std::filesystem::remove(path);
+  return bytes.str();
+}
+
+} // namespace remora::server

@@ -1,0 +1,88 @@
+// One editing session of `remora serve`: the mesh being edited, its Editor (multires/editor.h),
+// the region and handle transforms, and the undo/redo history. Thread-safe: every public call
+// locks the session. Long work (loading and preprocessing a mesh, or baking the current result
+// into a new base before a new region) runs on a worker thread; status() reports its progress,
+// and other calls throw Busy meanwhile.
+//
+// History: every load, region and committed transform is a snapshot (editor, region, k,
+// transforms). Undo and redo re-apply a snapshot; the same editor, region and transforms give the
+// same positions bit for bit. A new region after non-identity transforms first bakes the current
+// result into a new editor (the edited shape becomes the next input), as a user expects.
+#pragma once
+
+#include <condition_variable>
+#include <cstddef>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <Eigen/Core>
+#include <nlohmann/json.hpp>
+
+#include "remora/common/error.h"
+#include "remora/mesh/mesh.h"
+#include "remora/multires/editor.h"
+
+namespace remora::server {
+
+/// The session is working (or has nothing loaded) and cannot take the request now.
+class Busy : public Error {
+public:
+  using Error::Error;
+};
+
+struct SessionOptions {
+  int threads = 0;              ///< editor threads (0 = all)
+  std::size_t max_history = 64; ///< snapshots kept for undo
+  EditorOptions editor;         ///< defaults for every editor the session builds
+};
+
+class Session {
+public:
+  explicit Session(SessionOptions options = {});
+  ~Session(); ///< waits for the worker
+  Session(const Session&) = delete;
+  Session& operator=(const Session&) = delete;
+
+  /// Starts loading (parse, repair, preprocess) on the worker. `bytes` are a file's content, `name`
+  /// its file name (the extension gives the format). Throws Busy while other work runs.
+  void start_load(std::string bytes, std::string name);
+  /// Starts a new region on the worker (baking the current result first when a handle moved).
+  /// Validates ids and k first (InvalidArgument). Throws Busy while other work runs.
+  void start_region(std::vector<int> support, std::vector<std::vector<int>> handles, int k);
+  /// Blocks until the worker is idle (tests and the CLI).
+  void wait();
+
+  /// Moves handle j (live: not in the history until commit()). Returns the positions of
+  /// movable_vertices(), in that order, and the frame time in milliseconds.
+  std::vector<float> set_transform(int handle, const Transform& transform, double* frame_ms);
+  /// Records the live transforms as a snapshot (the end of a drag). No-op when nothing changed.
+  void commit();
+  bool undo(); ///< false when there is nothing to undo
+  bool redo();
+
+  nlohmann::json status() const;
+  /// The current region as {"support": [ids], "handles": [[ids], ...], "k": k}, or null.
+  nlohmann::json region() const;
+  /// Current positions of every vertex (Float32 x, y, z) and the faces (Uint32 triples).
+  std::vector<float> positions() const;
+  std::vector<std::uint32_t> indices() const;
+  /// The vertices that can move under the current region (sorted), as ids.
+  std::vector<std::uint32_t> movable_vertices() const;
+  /// The base surface (remeshed) under the current transforms, its faces, and its vertex areas
+  /// over their mean (the "coloured by vertex area" view).
+  std::vector<float> base_positions() const;
+  std::vector<std::uint32_t> base_indices() const;
+  std::vector<float> base_areas() const;
+  /// The current result in a file format ("obj", "ply", "stl").
+  std::string export_mesh(const std::string& format) const;
+
+private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+} // namespace remora::server

@@ -1,0 +1,282 @@
+// The API of `remora serve` (apps/server/api.h), driven as functions: no sockets. Every bad
+// request is a 4xx with a JSON error; the editing round trip (load, region, transform, commit,
+// undo, redo, export) keeps its promises.
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "api.h"
+#include "remora/geometry/selection.h"
+#include "remora/mesh/io.h"
+#include "remora/mesh/primitives.h"
+#include "session.h"
+
+namespace remora::server {
+namespace {
+
+using nlohmann::json;
+
+/// A bumpy sphere as OFF text.
+std::string sphere_off() {
+  Mesh m = make_icosphere(3, 1.0);
+  for (const VertexHandle v : m.vertices()) {
+    const Vec3 p = m.point(v);
+    m.set_point(v, p * (1.0 + 0.03 * std::sin(9 * p[0]) * std::sin(9 * p[1])));
+  }
+  const auto path = std::filesystem::temp_directory_path() / "remora_server_test_sphere.off";
+  write_mesh(path.string(), m);
+  std::ifstream in(path);
+  std::ostringstream s;
+  s << in.rdbuf();
+  std::filesystem::remove(path);
+  return s.str();
+}
+
+HttpResponse call(Session& s, const std::string& method, const std::string& path,
+                  const std::string& body = "", std::map<std::string, std::string> query = {}) {
+  return handle_api(s, HttpRequest{method, path, std::move(query), body});
+}
+
+template <class T>
+std::vector<T> as(const HttpResponse& r) {
+  std::vector<T> out(r.body.size() / sizeof(T));
+  std::memcpy(out.data(), r.body.data(), out.size() * sizeof(T));
+  return out;
+}
+
+void expect_error(const HttpResponse& r, int status, const std::string& part) {
+  EXPECT_EQ(r.status, status) << r.body;
+  const json j = json::parse(r.body, nullptr, false);
+  ASSERT_TRUE(j.is_object() && j.contains("error")) << r.body;
+  EXPECT_NE(j["error"].get<std::string>().find(part), std::string::npos) << r.body;
+}
+
+TEST(Server, EmptySessionAnswersStatusAndRefusesTheRest) {
+  Session s;
+  const HttpResponse status = call(s, "GET", "/api/status");
+  EXPECT_EQ(status.status, 200);
+  EXPECT_EQ(json::parse(status.body)["state"], "empty");
+  expect_error(call(s, "GET", "/api/mesh/positions"), 409, "no mesh");
+  expect_error(
+      call(s, "POST", "/api/transform", R"({"handle": 0, "matrix": [1,0,0,0,0,1,0,0,0,0,1,0]})"),
+      409, "no mesh");
+  expect_error(call(s, "GET", "/api/nowhere"), 404, "no endpoint");
+  expect_error(call(s, "POST", "/api/status"), 405, "does not take POST");
+  expect_error(call(s, "POST", "/api/load", "", {{"name", "a.ply"}}), 400, "empty");
+  expect_error(call(s, "POST", "/api/load", "x"), 400, "?name=");
+  expect_error(call(s, "POST", "/api/load", "x", {{"name", "a.doc"}}), 400, "extension");
+  ApiLimits small;
+  small.max_upload_bytes = 10;
+  EXPECT_EQ(
+      handle_api(s, {"POST", "/api/load", {{"name", "a.off"}}, std::string(11, 'x')}, small).status,
+      413);
+}
+
+TEST(Server, ABrokenUploadEndsInAnErrorTheStatusNames) {
+  Session s;
+  EXPECT_EQ(call(s, "POST", "/api/load", "OFF\n3 1 0\n0 0 0\n1 0 nan\n0 1 0\n3 0 1 2\n",
+                 {{"name", "bad.off"}})
+                .status,
+            202);
+  s.wait();
+  const json status = json::parse(call(s, "GET", "/api/status").body);
+  EXPECT_EQ(status["state"], "empty");
+  ASSERT_TRUE(status.contains("error"));
+  EXPECT_NE(status["error"].get<std::string>().find("bad.off"), std::string::npos) << status;
+}
+
+TEST(Server, EditRoundTripWithUndoAndRedo) {
+  Session s;
+  ASSERT_EQ(call(s, "POST", "/api/load", sphere_off(), {{"name", "sphere.off"}}).status, 202);
+  s.wait();
+  ASSERT_EQ(json::parse(call(s, "GET", "/api/status").body)["state"], "ready");
+  const auto indices = as<std::uint32_t>(call(s, "GET", "/api/mesh/indices"));
+  const auto before = as<float>(call(s, "GET", "/api/mesh/positions"));
+  ASSERT_EQ(indices.size() % 3, 0u);
+  const std::size_t n = before.size() / 3;
+  ASSERT_EQ(n, 642u);
+  // The region: vertices by height.
+  std::vector<int> support, handle;
+  for (std::size_t v = 0; v < n; ++v) {
+    if (before[3 * v + 2] > 0.2) support.push_back(static_cast<int>(v));
+    if (before[3 * v + 2] > 0.9) handle.push_back(static_cast<int>(v));
+  }
+  // Bad regions first.
+  expect_error(call(s, "POST", "/api/region", R"({"support": [1, 2)"), 400, "not valid JSON");
+  expect_error(call(s, "POST", "/api/region", R"({"support": [1], "handles": [[1]], "colour": 3})"),
+               400, "unknown key 'colour'");
+  expect_error(call(s, "POST", "/api/region", R"({"support": [1, -4], "handles": [[1]]})"), 400,
+               "support[1]");
+  expect_error(call(s, "POST", "/api/region", R"({"support": [1, 99999], "handles": [[1]]})"), 400,
+               "out of range");
+  expect_error(call(s, "POST", "/api/region", R"({"support": [1], "handles": [[1]], "k": 7})"), 400,
+               "k = 7");
+  expect_error(call(s, "POST", "/api/region", R"({"support": [], "handles": [[1]]})"), 400,
+               "empty");
+  expect_error(
+      call(s, "POST", "/api/transform", R"({"handle": 0, "matrix": [1,0,0,0,0,1,0,0,0,0,1,0]})"),
+      409, "no region");
+  // A handle outside the support: accepted by the API, refused by the editor on the worker.
+  ASSERT_EQ(call(s, "POST", "/api/region", json{{"support", {0, 1}}, {"handles", {handle}}}.dump())
+                .status,
+            202);
+  s.wait();
+  EXPECT_NE(json::parse(call(s, "GET", "/api/status").body)
+                .value("error", "")
+                .find("outside the support"),
+            std::string::npos);
+  // The real region.
+  ASSERT_EQ(call(s, "POST", "/api/region",
+                 json{{"support", support}, {"handles", {handle}}, {"k", 2}}.dump())
+                .status,
+            202);
+  s.wait();
+  const json ready = json::parse(call(s, "GET", "/api/status").body);
+  ASSERT_FALSE(ready.contains("error")) << ready;
+  EXPECT_EQ(ready["region"]["support"], support.size());
+  const auto movable = as<std::uint32_t>(call(s, "GET", "/api/movable"));
+  EXPECT_EQ(movable.size(), support.size());
+  EXPECT_EQ(json::parse(call(s, "GET", "/api/region").body)["handles"][0].size(), handle.size());
+  // Transforms: bad ones, then a lift by 0.5.
+  expect_error(call(s, "POST", "/api/transform", R"({"handle": 0, "matrix": [1,0,0]})"), 400,
+               "12 numbers");
+  expect_error(
+      call(s, "POST", "/api/transform", R"({"handle": 3, "matrix": [1,0,0,0,0,1,0,0,0,0,1,0]})"),
+      400, "handle 3");
+  expect_error(
+      call(s, "POST", "/api/transform", R"({"handle": 0, "matrix": [1,0,0,0,0,1,0,0,0,0,1,"x"]})"),
+      400, "matrix[11]");
+  const HttpResponse moved =
+      call(s, "POST", "/api/transform", R"({"handle": 0, "matrix": [1,0,0,0,0,1,0,0,0,0,1,0.5]})");
+  ASSERT_EQ(moved.status, 200) << moved.body;
+  EXPECT_EQ(moved.content_type, "application/octet-stream");
+  EXPECT_TRUE(moved.headers.count("X-Frame-Ms"));
+  const auto moved_positions = as<float>(moved);
+  ASSERT_EQ(moved_positions.size(), 3 * movable.size());
+  EXPECT_EQ(call(s, "POST", "/api/commit").status, 200);
+  const auto after = as<float>(call(s, "GET", "/api/mesh/positions"));
+  for (std::size_t i = 0; i < movable.size(); ++i)
+    for (int c = 0; c < 3; ++c)
+      EXPECT_EQ(after[3 * movable[i] + static_cast<std::size_t>(c)],
+                moved_positions[3 * i + static_cast<std::size_t>(c)]);
+  // The handle rose by 0.5; nothing outside the support moved.
+  double rise = 0;
+  for (const int v : handle)
+    rise +=
+        (after[3 * static_cast<std::size_t>(v) + 2] - before[3 * static_cast<std::size_t>(v) + 2]) /
+        double(handle.size());
+  EXPECT_NEAR(rise, 0.5, 0.02);
+  std::vector<char> in_support(n, 0);
+  for (const int v : support) in_support[static_cast<std::size_t>(v)] = 1;
+  for (std::size_t v = 0; v < n; ++v) {
+    if (in_support[v]) continue;
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_EQ(after[3 * v + static_cast<std::size_t>(c)],
+                before[3 * v + static_cast<std::size_t>(c)]);
+    }
+  }
+  // Undo twice: the region's identity state, then the bare mesh, exactly; redo comes back.
+  EXPECT_TRUE(json::parse(call(s, "POST", "/api/undo").body)["changed"]);
+  const auto undone = as<float>(call(s, "GET", "/api/mesh/positions"));
+  std::size_t differ = 0;
+  for (std::size_t i = 0; i < before.size(); ++i)
+    differ += std::abs(undone[i] - before[i]) > 1e-6f ? 1 : 0;
+  EXPECT_EQ(differ, 0u);
+  EXPECT_TRUE(json::parse(call(s, "POST", "/api/redo").body)["changed"]);
+  EXPECT_EQ(as<float>(call(s, "GET", "/api/mesh/positions")), after);
+  EXPECT_FALSE(json::parse(call(s, "POST", "/api/redo").body)["changed"]);
+  // Base views and exports.
+  const auto base_indices = as<std::uint32_t>(call(s, "GET", "/api/base/indices"));
+  const auto base_areas = as<float>(call(s, "GET", "/api/base/areas"));
+  EXPECT_EQ(as<float>(call(s, "GET", "/api/base/positions")).size(), 3 * base_areas.size());
+  EXPECT_GT(base_indices.size(), 0u);
+  for (const std::string format : {"obj", "ply", "stl"}) {
+    const HttpResponse r = call(s, "GET", "/api/export", "", {{"format", format}});
+    EXPECT_EQ(r.status, 200);
+    const SoupFile soup = read_soup_from_memory(r.body, format_from_path("x." + format), "export");
+    EXPECT_EQ(soup.soup.num_polygons(), indices.size() / 3) << format;
+  }
+  expect_error(call(s, "GET", "/api/export", "", {{"format", "doc"}}), 400,
+               "unknown export format");
+  // A new region after a move bakes the result into a new base: the moved shape stays.
+  ASSERT_EQ(call(s, "POST", "/api/region",
+                 json{{"support", support}, {"handles", {handle}}, {"k", 1}}.dump())
+                .status,
+            202);
+  s.wait();
+  EXPECT_EQ(as<float>(call(s, "GET", "/api/mesh/positions")).size(), after.size());
+  const auto baked = as<float>(call(s, "GET", "/api/mesh/positions"));
+  double baked_rise = 0;
+  for (const int v : handle)
+    baked_rise +=
+        (baked[3 * static_cast<std::size_t>(v) + 2] - before[3 * static_cast<std::size_t>(v) + 2]) /
+        double(handle.size());
+  EXPECT_NEAR(baked_rise, 0.5, 0.02);
+}
+
+TEST(Server, BusyWhileWorkingAndSafeUnderConcurrentRequests) {
+  Session s;
+  const std::string off = sphere_off();
+  ASSERT_EQ(call(s, "POST", "/api/load", off, {{"name", "sphere.off"}}).status, 202);
+  // A second load while the first runs is refused (or the first is already done).
+  const HttpResponse second = call(s, "POST", "/api/load", off, {{"name", "sphere.off"}});
+  EXPECT_TRUE(second.status == 409 || second.status == 202) << second.body;
+  s.wait();
+  // Many threads at once: statuses, positions and transforms interleave without harm.
+  const auto p = as<float>(call(s, "GET", "/api/mesh/positions"));
+  std::vector<int> support, handle;
+  for (std::size_t v = 0; v < p.size() / 3; ++v) {
+    if (p[3 * v] > 0.0) support.push_back(static_cast<int>(v));
+    if (p[3 * v] > 0.9) handle.push_back(static_cast<int>(v));
+  }
+  ASSERT_EQ(call(s, "POST", "/api/region", json{{"support", support}, {"handles", {handle}}}.dump())
+                .status,
+            202);
+  s.wait();
+  ASSERT_FALSE(json::parse(call(s, "GET", "/api/status").body).contains("error"));
+  std::vector<std::thread> threads;
+  std::atomic<int> bad{0};
+  for (int t = 0; t < 8; ++t)
+    threads.emplace_back([&, t] {
+      for (int i = 0; i < 20; ++i) {
+        const HttpResponse r =
+            (t % 2)
+                ? call(s, "GET", (i % 2) ? "/api/status" : "/api/mesh/positions")
+                : call(s, "POST", "/api/transform",
+                       json{{"handle", 0}, {"matrix", {1, 0, 0, 0.01 * i, 0, 1, 0, 0, 0, 0, 1, 0}}}
+                           .dump());
+        if (r.status != 200) ++bad;
+      }
+    });
+  for (auto& t : threads) t.join();
+  EXPECT_EQ(bad.load(), 0);
+}
+
+TEST(Server, StaticFilesStayInsideTheRoot) {
+  const auto root = std::filesystem::temp_directory_path() / "remora_web_root_test";
+  std::filesystem::create_directories(root / "three");
+  std::ofstream(root / "index.html") << "<html></html>";
+  std::ofstream(root / "three" / "a.js") << "export {};";
+  EXPECT_EQ(serve_static(root.string(), "/").status, 200);
+  EXPECT_EQ(serve_static(root.string(), "/").content_type, "text/html; charset=utf-8");
+  EXPECT_EQ(serve_static(root.string(), "/three/a.js").content_type,
+            "text/javascript; charset=utf-8");
+  EXPECT_EQ(serve_static(root.string(), "/../etc/passwd").status, 404);
+  EXPECT_EQ(serve_static(root.string(), "/three/../../x").status, 404);
+  EXPECT_EQ(serve_static(root.string(), "//etc/passwd").status, 404);
+  EXPECT_EQ(serve_static(root.string(), "/missing.js").status, 404);
+  std::filesystem::remove_all(root);
+}
+
+} // namespace
+} // namespace remora::server
