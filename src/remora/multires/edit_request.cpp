@@ -87,7 +87,9 @@ RegionSpec parse_region(const json& j, const std::string& path) {
   }
   only_keys(j, path, {"vertices", "sphere", "box", "geodesic", "union"});
   if (j.size() != 1) fail(path, "expected exactly one of vertices, sphere, box, geodesic, union");
-  const auto& [key, value] = *j.items().begin();
+  const auto first = j.begin();
+  const std::string key = first.key();
+  const json& value = first.value();
   const std::string sub = path + "." + key;
   if (key == "vertices") {
     r.kind = RegionSpec::Kind::Vertices;
