@@ -122,7 +122,7 @@ async function fetchMesh(fit) {
   scene.add(mesh);
   await fetchRegion();
   if (fit) fitCamera();
-  if ($('show-base').checked) await showBase(true);
+  if (baseShown()) await showBase(true);
 }
 
 function fitCamera() {
@@ -364,7 +364,7 @@ gizmo.addEventListener('dragging-changed', async (event) => {
     await task(async () => {
       await flush();
       try { await post('commit'); state.status = await json('status'); showStats(); } catch (e) { /* shown */ }
-      if ($('show-base').checked) await showBase(false);
+      if (baseShown()) await showBase(false);
     });
   }
 });
@@ -406,9 +406,15 @@ function applyMoved(moved) {
   g.computeBoundingSphere();
 }
 
-// ---- the base surface ---------------------------------------------------------------------------
+// ---- the base surface: shaded, and as a wireframe coloured by vertex area -----------------------
+let baseSurface = null;
+const baseShown = () => $('show-base').checked || $('show-wire').checked;
 async function showBase(refetchIndices) {
-  if (!$('show-base').checked) { if (baseLines) baseLines.visible = false; return; }
+  if (!baseShown()) {
+    if (baseLines) baseLines.visible = false;
+    if (baseSurface) baseSurface.visible = false;
+    return;
+  }
   const positions = await binary('base/positions', Float32Array);
   if (!baseLines || refetchIndices) {
     const indices = await binary('base/indices', Uint32Array);
@@ -423,14 +429,23 @@ async function showBase(refetchIndices) {
     geometry.setAttribute('position', new THREE.BufferAttribute(positions, 3));
     geometry.setAttribute('color', new THREE.BufferAttribute(colours, 3));
     geometry.setIndex(new THREE.BufferAttribute(indices, 1));
-    if (baseLines) { scene.remove(baseLines); baseLines.geometry.dispose(); }
+    geometry.computeVertexNormals();
+    for (const old of [baseLines, baseSurface]) if (old) scene.remove(old);
+    if (baseLines) baseLines.geometry.dispose();
     baseLines = new THREE.Mesh(geometry, new THREE.MeshBasicMaterial({ vertexColors: true, wireframe: true }));
+    baseSurface = new THREE.Mesh(geometry, new THREE.MeshStandardMaterial({
+      color: 0x8fb0d8, roughness: 0.6, side: THREE.DoubleSide,
+      polygonOffset: true, polygonOffsetFactor: 1, polygonOffsetUnits: 1 }));
+    scene.add(baseSurface);
     scene.add(baseLines);
   } else {
-    baseLines.geometry.getAttribute('position').array.set(positions);
-    baseLines.geometry.getAttribute('position').needsUpdate = true;
+    const attribute = baseLines.geometry.getAttribute('position');
+    attribute.array.set(positions);
+    attribute.needsUpdate = true;
+    baseLines.geometry.computeVertexNormals();
   }
-  baseLines.visible = true;
+  baseLines.visible = $('show-wire').checked;
+  baseSurface.visible = $('show-base').checked;
 }
 
 // ---- stats --------------------------------------------------------------------------------------
@@ -481,7 +496,8 @@ async function history(which) {
 }
 $('undo').onclick = () => task(() => history('undo'));
 $('redo').onclick = () => task(() => history('redo'));
-$('show-base').onchange = () => showBase(true);
+$('show-base').onchange = () => task(() => showBase(false));
+$('show-wire').onchange = () => task(() => showBase(false));
 $('show-mesh').onchange = () => { if (mesh) mesh.visible = $('show-mesh').checked; };
 window.addEventListener('keydown', (event) => {
   if (event.target.tagName === 'INPUT') return;

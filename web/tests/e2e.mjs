@@ -114,6 +114,11 @@ try {
       for (let c = 0; c < 3; ++c) if (after[3 * v + c] !== before[3 * v + c]) { outsideMoved += 1; break; }
   check(outsideMoved === 0, `no vertex outside the support moved (${outsideMoved} did)`);
   if (args.screenshots) await page.screenshot({ path: join(args.screenshots, 'editor-dragged.png') });
+  // The hidden base and its wireframe coloured by vertex area.
+  await page.check('#show-wire');
+  await page.waitForFunction(() => window.remora.ready(), null, { timeout: 60000 });
+  if (args.screenshots) await page.screenshot({ path: join(args.screenshots, 'editor-base-wireframe.png') });
+  await page.uncheck('#show-wire');
 
   // Undo (the button) restores the positions before the drag exactly.
   await page.click('#undo');
