@@ -112,6 +112,9 @@ TEST(Selection, SpheresBoxesAndGeodesicDiscs) {
   ASSERT_EQ(order.size(), 5u);
   EXPECT_EQ(order[0], 60);
   EXPECT_THROW(geodesic_order(grid, VertexHandle(1000)), InvalidArgument);
+  EXPECT_EQ(nearest_vertex(grid, Vec3(0.31, 0.69, 5)).idx(), 7 * 11 + 3);
+  EXPECT_EQ(central_vertex(grid).idx(), 60); // (0.5, 0.5)
+  EXPECT_THROW(nearest_vertex(Mesh(), Vec3(0, 0, 0)), InvalidArgument);
 }
 
 TEST(EditRequest, SelectsRegionsAndMapsFileIds) {

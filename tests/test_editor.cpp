@@ -312,15 +312,7 @@ TEST(Editor, NeedleMeshesGiveNoNanAndKeepTheFixedRest) {
     const Mesh mesh = read_mesh(path).mesh;
     const BoundingBox box = bounding_box(mesh);
     // Spheres around the vertex nearest the bounding box's center (which may lie in a hole).
-    Vec3 center = (box.min + box.max) * 0.5;
-    double nearest = 1e300;
-    Vec3 closest = center;
-    for (const VertexHandle v : mesh.vertices())
-      if ((mesh.point(v) - center).sqrnorm() < nearest) {
-        nearest = (mesh.point(v) - center).sqrnorm();
-        closest = mesh.point(v);
-      }
-    center = closest;
+    const Vec3 center = mesh.point(nearest_vertex(mesh, (box.min + box.max) * 0.5));
     const double diagonal = box.diagonal();
     const auto support = select_sphere(mesh, center, 0.3 * diagonal);
     const auto handle = select_sphere(mesh, center, 0.08 * diagonal);

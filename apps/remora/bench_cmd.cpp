@@ -95,16 +95,7 @@ void add_bench_command(CLI::App& app) {
       remesh_s = seconds_since(t0);
     }
     // Seed: the vertex nearest the centroid.
-    Vec3 centroid(0, 0, 0);
-    for (auto v : mesh.vertices()) centroid += mesh.point(v);
-    centroid /= static_cast<double>(mesh.n_vertices());
-    VertexHandle seed(0);
-    double best = std::numeric_limits<double>::infinity();
-    for (auto v : mesh.vertices())
-      if ((mesh.point(v) - centroid).sqrnorm() < best) {
-        best = (mesh.point(v) - centroid).sqrnorm();
-        seed = v;
-      }
+    const VertexHandle seed = central_vertex(mesh);
     std::vector<std::string> names = a->solvers;
     if (names.empty()) {
       // Every solver of this build, the variants (METIS ordering, incomplete Cholesky) next to

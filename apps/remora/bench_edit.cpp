@@ -5,7 +5,6 @@
 #include <algorithm>
 #include <chrono>
 #include <iostream>
-#include <limits>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -70,16 +69,7 @@ void add_bench_edit_command(CLI::App& bench) {
 
     // A geodesic support around the vertex nearest the centroid, sized so that about
     // `support` base vertices are free; the handle is its innermost 3 %.
-    Vec3 centroid(0, 0, 0);
-    for (const VertexHandle v : mesh.vertices()) centroid += mesh.point(v);
-    centroid /= double(mesh.n_vertices());
-    VertexHandle seed(0);
-    double best = std::numeric_limits<double>::infinity();
-    for (const VertexHandle v : mesh.vertices())
-      if ((mesh.point(v) - centroid).sqrnorm() < best) {
-        best = (mesh.point(v) - centroid).sqrnorm();
-        seed = v;
-      }
+    const VertexHandle seed = central_vertex(mesh);
     const double ratio = double(mesh.n_vertices()) / double(editor.base().n_vertices());
     const auto wanted = static_cast<std::size_t>(
         std::min(double(a->support) * 1.03, 0.9 * double(editor.base().n_vertices())) * ratio);

@@ -7,7 +7,6 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
-#include <limits>
 #include <sstream>
 #include <thread>
 
@@ -88,16 +87,7 @@ void add_bench_serve_command(CLI::App& bench) {
     // The support: a geodesic disc around the vertex nearest the centroid; the handle its
     // innermost 3 %.
     const Mesh mesh = read_mesh(a->mesh).mesh;
-    Vec3 centroid(0, 0, 0);
-    for (const VertexHandle v : mesh.vertices()) centroid += mesh.point(v);
-    centroid /= double(mesh.n_vertices());
-    VertexHandle seed(0);
-    double best = std::numeric_limits<double>::infinity();
-    for (const VertexHandle v : mesh.vertices())
-      if ((mesh.point(v) - centroid).sqrnorm() < best) {
-        best = (mesh.point(v) - centroid).sqrnorm();
-        seed = v;
-      }
+    const VertexHandle seed = central_vertex(mesh);
     const std::vector<int> support =
         geodesic_order(mesh, seed, static_cast<std::size_t>(a->support));
     const std::vector<int> handle(

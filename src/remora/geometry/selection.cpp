@@ -81,6 +81,32 @@ std::vector<int> geodesic_order(const Mesh& mesh, VertexHandle seed, std::size_t
   return order;
 }
 
+VertexHandle nearest_vertex(const Mesh& mesh, const Vec3& point) {
+  if (!finite(point)) throw InvalidArgument("nearest_vertex: the point is not finite");
+  VertexHandle best;
+  double best_d2 = std::numeric_limits<double>::infinity();
+  for (const VertexHandle v : mesh.vertices()) {
+    const double d2 = (mesh.point(v) - point).sqrnorm();
+    if (d2 < best_d2) {
+      best_d2 = d2;
+      best = v;
+    }
+  }
+  if (!best.is_valid()) throw InvalidArgument("nearest_vertex: the mesh has no vertices");
+  return best;
+}
+
+VertexHandle central_vertex(const Mesh& mesh) {
+  Vec3 centroid(0, 0, 0);
+  std::size_t count = 0;
+  for (const VertexHandle v : mesh.vertices()) {
+    centroid += mesh.point(v);
+    ++count;
+  }
+  if (count == 0) throw InvalidArgument("central_vertex: the mesh has no vertices");
+  return nearest_vertex(mesh, centroid / double(count));
+}
+
 std::vector<int> select_geodesic_disc(const Mesh& mesh, VertexHandle seed, double radius) {
   if (!(radius >= 0.0) || std::isnan(radius))
     throw InvalidArgument(fmt::format("geodesic selection: the radius {} must be >= 0", radius));

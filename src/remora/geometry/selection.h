@@ -27,6 +27,13 @@ std::vector<int> geodesic_order(const Mesh& mesh, VertexHandle seed,
                                 std::size_t max_count = std::numeric_limits<std::size_t>::max(),
                                 double max_distance = std::numeric_limits<double>::infinity());
 
+/// The vertex nearest to `point` (the first of equals by index). Throws InvalidArgument for a
+/// mesh without vertices or a non-finite point.
+VertexHandle nearest_vertex(const Mesh& mesh, const Vec3& point);
+
+/// The vertex nearest to the mean of all vertices: the benchmarks' seed for geodesic supports.
+VertexHandle central_vertex(const Mesh& mesh);
+
 /// geodesic_order(mesh, seed, all, radius), sorted by index: a geodesic disc around `seed`.
 std::vector<int> select_geodesic_disc(const Mesh& mesh, VertexHandle seed, double radius);
 
