@@ -26,19 +26,22 @@ namespace {
 
 using nlohmann::json;
 
-/// A bumpy sphere as OFF text.
+/// A bumpy sphere as OFF text, made in memory (tests run in parallel: no shared temporary file).
 std::string sphere_off() {
   Mesh m = make_icosphere(3, 1.0);
-  for (const VertexHandle v : m.vertices()) {
-    const Vec3 p = m.point(v);
-    m.set_point(v, p * (1.0 + 0.03 * std::sin(9 * p[0]) * std::sin(9 * p[1])));
-  }
-  const auto path = std::filesystem::temp_directory_path() / "remora_server_test_sphere.off";
-  write_mesh(path.string(), m);
-  std::ifstream in(path);
   std::ostringstream s;
-  s << in.rdbuf();
-  std::filesystem::remove(path);
+  s.precision(17);
+  s << "OFF\n" << m.n_vertices() << " " << m.n_faces() << " 0\n";
+  for (const VertexHandle v : m.vertices()) {
+    const Vec3 p =
+        m.point(v) * (1.0 + 0.03 * std::sin(9 * m.point(v)[0]) * std::sin(9 * m.point(v)[1]));
+    s << p[0] << " " << p[1] << " " << p[2] << "\n";
+  }
+  for (const FaceHandle f : m.faces()) {
+    s << 3;
+    for (const VertexHandle v : m.fv_range(f)) s << " " << v.idx();
+    s << "\n";
+  }
   return s.str();
 }
 
