@@ -265,6 +265,34 @@ TEST(Server, BusyWhileWorkingAndSafeUnderConcurrentRequests) {
   EXPECT_EQ(bad.load(), 0);
 }
 
+TEST(Server, TheHistoryKeepsFewEditorsAlive) {
+  SessionOptions options;
+  options.max_editors = 1;
+  Session s(options);
+  ASSERT_EQ(call(s, "POST", "/api/load", sphere_off(), {{"name", "sphere.off"}}).status, 202);
+  s.wait();
+  const auto p = as<float>(call(s, "GET", "/api/mesh/positions"));
+  std::vector<int> support, handle;
+  for (std::size_t v = 0; v < p.size() / 3; ++v) {
+    if (p[3 * v + 1] > 0.0) support.push_back(static_cast<int>(v));
+    if (p[3 * v + 1] > 0.9) handle.push_back(static_cast<int>(v));
+  }
+  const std::string region = json{{"support", support}, {"handles", {handle}}}.dump();
+  ASSERT_EQ(call(s, "POST", "/api/region", region).status, 202);
+  s.wait();
+  ASSERT_EQ(
+      call(s, "POST", "/api/transform", R"({"handle": 0, "matrix": [1,0,0,0,0,1,0,0.3,0,0,1,0]})")
+          .status,
+      200);
+  call(s, "POST", "/api/commit");
+  EXPECT_TRUE(json::parse(call(s, "GET", "/api/status").body)["undo"]);
+  // A new region after the move bakes a new editor; with room for one, the old history goes.
+  ASSERT_EQ(call(s, "POST", "/api/region", region).status, 202);
+  s.wait();
+  EXPECT_FALSE(json::parse(call(s, "GET", "/api/status").body)["undo"]);
+  EXPECT_FALSE(json::parse(call(s, "POST", "/api/undo").body)["changed"]);
+}
+
 TEST(Server, StaticFilesStayInsideTheRoot) {
   const auto root = std::filesystem::temp_directory_path() / "remora_web_root_test";
   std::filesystem::create_directories(root / "three");

@@ -1,5 +1,6 @@
 #include "session.h"
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cstdio>
@@ -82,7 +83,18 @@ struct Session::Impl {
   void push_snapshot() {
     if (!history.empty()) history.resize(cursor + 1); // drop the redo branch
     history.push_back({box, region, transforms});
-    if (history.size() > options.max_history) history.erase(history.begin());
+    // Old snapshots go first when there are too many, or when they keep too many editors alive
+    // (each bake made one; an editor of a million-triangle mesh holds about a gigabyte).
+    auto editors = [&] {
+      std::vector<const EditorBox*> distinct;
+      for (const Snapshot& s : history)
+        if (std::find(distinct.begin(), distinct.end(), s.box.get()) == distinct.end())
+          distinct.push_back(s.box.get());
+      return distinct.size();
+    };
+    while (history.size() > 1 &&
+           (history.size() > options.max_history || editors() > options.max_editors))
+      history.erase(history.begin());
     cursor = history.size() - 1;
   }
   /// Re-applies a snapshot (undo/redo): same editor, region and transforms, same positions.

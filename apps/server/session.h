@@ -37,6 +37,7 @@ public:
 struct SessionOptions {
   int threads = 0;              ///< editor threads (0 = all)
   std::size_t max_history = 64; ///< snapshots kept for undo
+  std::size_t max_editors = 3;  ///< distinct editors (one per bake) the history keeps alive
   EditorOptions editor;         ///< defaults for every editor the session builds
 };
 
