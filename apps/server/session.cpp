@@ -322,26 +322,24 @@ nlohmann::json Session::region() const {
   return {{"support", m.region->support}, {"handles", m.region->handles}, {"k", m.region->k}};
 }
 
+namespace {
+/// Rows x, y, z of `p` as interleaved Float32, the API's wire format.
+std::vector<float> to_floats(const Eigen::MatrixXd& p) {
+  std::vector<float> out(3 * static_cast<std::size_t>(p.rows()));
+  for (Eigen::Index v = 0; v < p.rows(); ++v)
+    for (int c = 0; c < 3; ++c)
+      out[3 * static_cast<std::size_t>(v) + static_cast<std::size_t>(c)] =
+          static_cast<float>(p(v, c));
+  return out;
+}
+} // namespace
+
 std::vector<float> Session::positions() const {
   std::lock_guard lock(impl_->mutex);
   const Impl& m = *impl_;
   m.require_ready();
   Editor& editor = m.box->editor;
-  const Mesh& input = editor.input();
-  std::vector<float> out(3 * input.n_vertices());
-  if (m.region) {
-    const Eigen::MatrixXd& p = editor.positions();
-    for (Eigen::Index v = 0; v < p.rows(); ++v)
-      for (int c = 0; c < 3; ++c)
-        out[3 * static_cast<std::size_t>(v) + static_cast<std::size_t>(c)] =
-            static_cast<float>(p(v, c));
-  } else {
-    for (const VertexHandle v : input.vertices())
-      for (int c = 0; c < 3; ++c)
-        out[3 * static_cast<std::size_t>(v.idx()) + static_cast<std::size_t>(c)] =
-            static_cast<float>(input.point(v)[c]);
-  }
-  return out;
+  return to_floats(m.region ? editor.positions() : positions_matrix(editor.input()));
 }
 
 namespace {
@@ -372,23 +370,8 @@ std::vector<float> Session::base_positions() const {
   std::lock_guard lock(impl_->mutex);
   const Impl& m = *impl_;
   m.require_ready();
-  std::vector<float> out;
-  if (m.region) {
-    const Eigen::MatrixXd& p = m.box->editor.base_positions();
-    out.resize(3 * static_cast<std::size_t>(p.rows()));
-    for (Eigen::Index v = 0; v < p.rows(); ++v)
-      for (int c = 0; c < 3; ++c)
-        out[3 * static_cast<std::size_t>(v) + static_cast<std::size_t>(c)] =
-            static_cast<float>(p(v, c));
-    return out;
-  }
-  const Mesh& base = m.box->editor.base();
-  out.resize(3 * base.n_vertices());
-  for (const VertexHandle v : base.vertices())
-    for (int c = 0; c < 3; ++c)
-      out[3 * static_cast<std::size_t>(v.idx()) + static_cast<std::size_t>(c)] =
-          static_cast<float>(base.point(v)[c]);
-  return out;
+  Editor& editor = m.box->editor;
+  return to_floats(m.region ? editor.base_positions() : positions_matrix(editor.base()));
 }
 
 std::vector<std::uint32_t> Session::base_indices() const {

@@ -480,6 +480,14 @@ void Editor::set_region(const std::vector<int>& support,
   m.report.milliseconds["set_region"] = ms_since(t_start);
 }
 
+namespace {
+void check_handle(const RegionState& r, int handle) {
+  if (handle < 0 || handle >= r.handles)
+    throw InvalidArgument(
+        fmt::format("handle {} does not exist: there are {} handles", handle, r.handles));
+}
+} // namespace
+
 int Editor::handle_count() const {
   return impl_->region ? impl_->region->handles : 0;
 }
@@ -498,17 +506,13 @@ void Editor::set_system(const KHarmonicOptions& system) {
 
 Eigen::Vector3d Editor::handle_center(int handle) const {
   const RegionState& r = impl_->state();
-  if (handle < 0 || handle >= r.handles)
-    throw InvalidArgument(
-        fmt::format("handle {} does not exist: there are {} handles", handle, r.handles));
+  check_handle(r, handle);
   return r.handle_centers[static_cast<std::size_t>(handle)];
 }
 
 void Editor::set_transform(int handle, const Transform& transform) {
   RegionState& r = impl_->state();
-  if (handle < 0 || handle >= r.handles)
-    throw InvalidArgument(
-        fmt::format("handle {} does not exist: there are {} handles", handle, r.handles));
+  check_handle(r, handle);
   if (!transform.allFinite())
     throw InvalidArgument(
         fmt::format("the transform of handle {} has a NaN or infinite entry", handle));
@@ -518,9 +522,7 @@ void Editor::set_transform(int handle, const Transform& transform) {
 
 const Transform& Editor::transform(int handle) const {
   const RegionState& r = impl_->state();
-  if (handle < 0 || handle >= r.handles)
-    throw InvalidArgument(
-        fmt::format("handle {} does not exist: there are {} handles", handle, r.handles));
+  check_handle(r, handle);
   return r.transforms[static_cast<std::size_t>(handle)];
 }
 
