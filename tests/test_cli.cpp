@@ -1,10 +1,12 @@
 // The `remora` command line tool, run as a user would: exit codes, one clear error line, JSON
 // that parses and agrees with the library, files written only on success.
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <random>
 #include <sstream>
 #include <string>
 
@@ -158,6 +160,39 @@ TEST_F(Cli, RemeshWritesTheMeshAndAReportThatAgreesWithIt) {
   EXPECT_NE(table.out.find("Laplacian symmetry defect"), std::string::npos) << table.out;
 }
 
+// --low-pass remeshes the editor's base surface: on a sphere with radial noise, the output's
+// radii spread far less than the input's, and far less than without the flag.
+TEST_F(Cli, RemeshLowPassRemeshesTheSmoothedSurface) {
+  Mesh sphere = make_icosphere(4);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> noise(-0.03, 0.03);
+  for (const VertexHandle v : sphere.vertices())
+    sphere.set_point(v, sphere.point(v) * (1.0 + noise(rng)));
+  const fs::path in = dir_ / "noisy.off";
+  write_mesh(in.string(), sphere);
+  auto radius_spread = [](const Mesh& m) {
+    double sum = 0, sum2 = 0;
+    for (const VertexHandle v : m.vertices()) {
+      const double r = m.point(v).norm();
+      sum += r;
+      sum2 += r * r;
+    }
+    const double n = static_cast<double>(m.n_vertices()), mean = sum / n;
+    return std::sqrt(std::max(0.0, sum2 / n - mean * mean)) / mean;
+  };
+  const fs::path plain = dir_ / "plain.obj", smooth = dir_ / "smooth.obj";
+  ASSERT_EQ(run("remesh " + in.string() + " -o " + plain.string()).exit_code, 0);
+  const CliRun r = run("remesh " + in.string() + " -o " + smooth.string() + " --low-pass 2");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const double input = radius_spread(sphere);
+  const double without = radius_spread(read_mesh(plain.string()).mesh);
+  const double with = radius_spread(read_mesh(smooth.string()).mesh);
+  EXPECT_GT(without, 0.5 * input); // remeshing alone keeps the noise it projects onto
+  EXPECT_LT(with, 0.25 * input) << "input " << input << ", without " << without;
+  EXPECT_EQ(run("remesh " + in.string() + " -o " + smooth.string() + " --low-pass -1").exit_code,
+            2);
+}
+
 TEST_F(Cli, RemeshRejectsBadOptionsBeforeWorking) {
   const fs::path in = dir_ / "sphere.off";
   write_mesh(in.string(), make_icosphere(1));
@@ -177,12 +212,13 @@ TEST_F(Cli, BenchSolversAgreeAndRefuseSupportsLargerThanTheMesh) {
   const fs::path in = dir_ / "sphere.off";
   write_mesh(in.string(), make_icosphere(4)); // 2,562 vertices
   const CliRun r = run("bench solvers " + in.string() +
-                       " --no-remesh --sizes 1000 --solvers ldlt,cg,multigrid --json");
+                       " --no-remesh --sizes 1000 --solvers ldlt,cg,multigrid,basis --json");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const nlohmann::json j = nlohmann::json::parse(r.out);
   const auto& rows = j["supports"][0]["rows"];
-  ASSERT_EQ(rows.size(), 3u);
+  ASSERT_EQ(rows.size(), 4u);
   for (const auto& row : rows) {
+    EXPECT_GE(row["moves_timed"].get<int>(), 1) << row;
     EXPECT_EQ(row["note"].get<std::string>().find("error"), std::string::npos) << row;
     EXPECT_LE(row["residual"].get<double>(), 1e-9) << row;
     EXPECT_LE(row["max_difference"].get<double>(), 1e-6) << row;

@@ -93,6 +93,34 @@ TEST(Solver, RefactorizationReusesTheAnalysis) {
   }
 }
 
+// A drag solves many times on one factor, with any number of columns (3 for x, y, z; 3 + 4h for
+// the editor's basis functions; 1): each answer is right, and owns its storage (the direct
+// solvers keep their workspace between calls).
+TEST(Solver, RepeatedSolvesWithChangingColumnCountsStayRightAndIndependent) {
+  const KHarmonicSystem s = sphere_system(2, AreaWeights::Mean);
+  const Eigen::MatrixXd b3 = block_rhs(s);
+  Eigen::MatrixXd b7(b3.rows(), 7);
+  b7 << b3, -b3, b3.col(0) + b3.col(1);
+  const Eigen::MatrixXd b1 = b3.col(2);
+  for (const std::string& name : solver_names()) {
+    if (name == "bicgstab" || name == "lu" || name == "cg") continue; // direct solvers
+    auto solver = make_solver({.name = name, .tolerance = 1e-12});
+    SCOPED_TRACE(name);
+    solver->compute(s.matrix);
+    const Eigen::MatrixXd x3 = solver->solve(b3);
+    const Eigen::MatrixXd x7 = solver->solve(b7);
+    const Eigen::MatrixXd x1 = solver->solve(b1);
+    const Eigen::MatrixXd x3_again = solver->solve(b3);
+    EXPECT_LE((s.matrix * x3 - b3).norm() / b3.norm(), 1e-9);
+    EXPECT_LE((s.matrix * x7 - b7).norm() / b7.norm(), 1e-9);
+    EXPECT_LE((s.matrix * x1 - b1).norm() / b1.norm(), 1e-9);
+    EXPECT_LE(relative_difference(x7.leftCols(3), x3), 1e-12);
+    EXPECT_LE(relative_difference(x7.middleCols(3, 3), -x3), 1e-12);
+    EXPECT_LE(relative_difference(x1, x3.col(2)), 1e-12);
+    EXPECT_EQ(x3_again, x3);
+  }
+}
+
 TEST(Solver, IterativeSolversReportIterationsAndUseTheStartValue) {
   const KHarmonicSystem s = sphere_system(2, AreaWeights::Mean);
   const Eigen::MatrixXd b = block_rhs(s);

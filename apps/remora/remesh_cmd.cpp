@@ -6,7 +6,9 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
+#include "remora/linalg/kharmonic.h"
 #include "remora/mesh/io.h"
+#include "remora/multires/base_surface.h"
 #include "remora/remesh/remesh.h"
 #include "report.h"
 
@@ -71,6 +73,7 @@ void add_remesh_command(CLI::App& app) {
   struct Args {
     std::string in, out;
     double length = 0, factor = 0.9, lambda = 0.5, smoothing = 1.5;
+    double low_pass = 0; ///< σ of the base-surface filter, in mean edge lengths; 0 = off
     std::string method = "newton";
     int cycles = 5, equalize = 10, threads = 0;
     bool no_project = false, report = false, json = false;
@@ -103,9 +106,22 @@ void add_remesh_command(CLI::App& app) {
                 "Keep vertex updates in the tangent plane instead of projecting onto the input");
   cmd->add_flag("--report", a->report, "Print quality figures, operation counts and timings");
   cmd->add_flag("--json", a->json, "Print the report as one JSON object");
+  cmd->add_option("--low-pass", a->low_pass,
+                  "Remesh the low-pass filtered surface instead, as `remora edit` builds its base "
+                  "(sigma in mean edge lengths; the editor's default is 2)")
+      ->check(CLI::NonNegativeNumber);
   cmd->callback([a] {
     format_from_path(a->out); // fail on an unknown extension before the long work
-    const LoadResult loaded = read_mesh(a->in);
+    LoadResult loaded = read_mesh(a->in);
+    if (a->low_pass > 0) {
+      // The editor's base surface S (multires/base_surface.h): same connectivity, smooth points.
+      LowPassFilter filter(loaded.mesh, {.smoothing = a->low_pass});
+      const Eigen::MatrixXd smooth = filter.apply(positions_matrix(loaded.mesh));
+      for (const VertexHandle v : loaded.mesh.vertices()) {
+        const auto r = smooth.row(v.idx());
+        loaded.mesh.set_point(v, Vec3(r[0], r[1], r[2]));
+      }
+    }
     RemeshOptions options;
     options.target_length = a->length;
     options.length_factor = a->factor;

@@ -131,15 +131,40 @@ public:
     stats_.factor_bytes = l->xsize * sizeof(double) + l->ssize * sizeof(SuiteSparse_long) +
                           static_cast<std::size_t>(l->n) * 4 * sizeof(SuiteSparse_long);
   }
+  // cholmod_solve2 with the solution and workspace kept between calls: a drag solves once per
+  // handle move, and each call then allocates nothing (Eigen's wrapper allocates and copies).
   Eigen::MatrixXd solve(const Eigen::MatrixXd& b, const Eigen::MatrixXd*) override {
     require_rhs(n_, b, "cholmod");
-    return llt_.solve(b);
+    cholmod_factor* l = const_cast<cholmod_factor*>(llt_.factor());
+    if (l == nullptr) throw InvalidArgument("cholmod: solve() before factorize()");
+    cholmod_dense rhs{};
+    rhs.nrow = rhs.d = static_cast<std::size_t>(b.rows());
+    rhs.ncol = static_cast<std::size_t>(b.cols());
+    rhs.nzmax = rhs.nrow * rhs.ncol;
+    rhs.x = const_cast<double*>(b.data());
+    rhs.xtype = CHOLMOD_REAL;
+    rhs.dtype = CHOLMOD_DOUBLE;
+    cholmod_common& c = llt_.cholmod();
+    if (!cholmod_solve2(CHOLMOD_A, l, &rhs, nullptr, &x_, nullptr, &y_, &e_, &c) || x_ == nullptr)
+      throw NumericalError("cholmod: the solve failed (out of memory?)");
+    return Eigen::Map<const Eigen::MatrixXd>(static_cast<const double*>(x_->x), b.rows(), b.cols());
   }
+  ~CholmodSolver() override {
+    cholmod_common& c = llt_.cholmod();
+    cholmod_free_dense(&x_, &c);
+    cholmod_free_dense(&y_, &c);
+    cholmod_free_dense(&e_, &c);
+  }
+  CholmodSolver(const CholmodSolver&) = delete;
+  CholmodSolver& operator=(const CholmodSolver&) = delete;
 
 private:
   bool metis_;
   ExposedCholmod llt_;
   Eigen::Index n_ = 0;
+  cholmod_dense* x_ = nullptr; // solution, reused by cholmod_solve2
+  cholmod_dense* y_ = nullptr; // workspace
+  cholmod_dense* e_ = nullptr; // workspace
 };
 #endif
 
