@@ -204,17 +204,20 @@ void add_bench_command(CLI::App& app) {
                      : full == "basis" ? default_solver_name() + " + handle basis"
                                        : full;
         row.system = system_name;
-        // Times solve(m) for moves 0, 1, ... until kMoves are done or a second has passed
-        // (iterative solvers take seconds: one move). "3 solves" is the median, the first move
-        // is reported apart. Returns the solution of move 0.
-        auto time_moves = [&](const std::function<Eigen::MatrixXd(int)>& solve) {
+        // Times solve(input(m)) for moves m = 0, 1, ... until kMoves are done or a second has
+        // passed (iterative solvers take seconds: one move); input(m) is built untimed. "3 solves"
+        // is the median, the first move is reported apart. Returns the solution of move 0.
+        using Input = std::function<Eigen::MatrixXd(int)>;
+        using Solve = std::function<Eigen::MatrixXd(const Eigen::MatrixXd&)>;
+        auto time_moves = [&](const Input& input, const Solve& solve) {
           constexpr int kMoves = 7;
           std::vector<double> seconds;
           Eigen::MatrixXd first;
           const auto start = Clock::now();
           for (int m = 0; m < kMoves && (m == 0 || seconds_since(start) < 1.0); ++m) {
+            const Eigen::MatrixXd in = input(m);
             const auto t0 = Clock::now();
-            Eigen::MatrixXd x = solve(m);
+            Eigen::MatrixXd x = solve(in);
             seconds.push_back(seconds_since(t0));
             if (m == 0) first = std::move(x);
           }
@@ -230,14 +233,13 @@ void add_bench_command(CLI::App& app) {
             const auto t0 = Clock::now();
             multigrid->set_region(region);
             row.precompute_s = seconds_since(t0);
-            std::vector<Eigen::MatrixXd> moved(7, positions);
-            for (int m = 0; m < 7; ++m)
+            auto moved = [&](int m) { // all positions, the handle's moved
+              Eigen::MatrixXd p = positions;
               for (std::size_t v = 0; v < region.label.size(); ++v)
-                if (region.label[v] == 0)
-                  moved[static_cast<std::size_t>(m)].row(static_cast<Eigen::Index>(v)) +=
-                      move_shift(m);
-            x = time_moves(
-                [&](int m) { return multigrid->solve(moved[static_cast<std::size_t>(m)]); });
+                if (region.label[v] == 0) p.row(static_cast<Eigen::Index>(v)) += move_shift(m);
+              return p;
+            };
+            x = time_moves(moved, [&](const Eigen::MatrixXd& p) { return multigrid->solve(p); });
             const auto stats = multigrid->stats();
             row.iterations = stats.front().iterations;
             std::string sizes;
@@ -263,13 +265,15 @@ void add_bench_command(CLI::App& app) {
             }
             const Eigen::MatrixXd basis = solver->solve(system.rhs(values));
             row.precompute_s = seconds_since(t0);
-            x = time_moves([&](int m) {
-              Eigen::Matrix<double, 7, 3> coefficients;
-              coefficients.topRows(3).setIdentity();       // the rest
-              coefficients.middleRows(3, 3).setIdentity(); // the handle's linear part
-              coefficients.row(6) = move_shift(m);         // its translation
-              return Eigen::MatrixXd(basis * coefficients);
-            });
+            auto coefficients = [&](int m) {
+              Eigen::MatrixXd c = Eigen::MatrixXd::Zero(7, 3);
+              c.topRows(3).setIdentity();       // the rest
+              c.middleRows(3, 3).setIdentity(); // the handle's linear part
+              c.row(6) = move_shift(m);         // its translation
+              return c;
+            };
+            x = time_moves(coefficients,
+                           [&](const Eigen::MatrixXd& c) { return Eigen::MatrixXd(basis * c); });
             row.note = "precomputation includes the 7 basis solves; a move is a product";
           } else {
             auto solver = make_solver(options);
@@ -283,9 +287,7 @@ void add_bench_command(CLI::App& app) {
               solver->factorize(system.matrix);
               row.refactor_s = seconds_since(t2);
             }
-            std::vector<Eigen::MatrixXd> b;
-            for (int m = 0; m < 7; ++m) b.push_back(rhs_of_move(m));
-            x = time_moves([&](int m) { return solver->solve(b[static_cast<std::size_t>(m)]); });
+            x = time_moves(rhs_of_move, [&](const Eigen::MatrixXd& b) { return solver->solve(b); });
             const SolverStats stats = solver->stats();
             row.iterations = stats.iterations;
             row.factor_bytes = stats.factor_bytes;
