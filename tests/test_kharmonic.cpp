@@ -49,6 +49,17 @@ Region disc_region(const Mesh& mesh, double inner, double outer) {
   return region;
 }
 
+TEST(KHarmonic, PositionsGoToAMatrixAndBack) {
+  Mesh mesh = make_icosphere(2);
+  const Eigen::MatrixXd p = positions_matrix(mesh);
+  ASSERT_EQ(p.rows(), static_cast<Eigen::Index>(mesh.n_vertices()));
+  const Eigen::MatrixXd moved = 2.0 * p + Eigen::MatrixXd::Ones(p.rows(), 3);
+  set_positions(mesh, moved);
+  EXPECT_EQ(positions_matrix(mesh), moved);
+  EXPECT_THROW(set_positions(mesh, moved.topRows(3)), InvalidArgument);
+  EXPECT_THROW(set_positions(mesh, moved.leftCols(2)), InvalidArgument);
+}
+
 TEST(KHarmonic, ConstantsAreInTheKernelForEveryKAndWeighting) {
   Mesh mesh = make_icosphere(3);
   Region region = Region::all_fixed(mesh.n_vertices());

@@ -116,11 +116,7 @@ void add_remesh_command(CLI::App& app) {
     if (a->low_pass > 0) {
       // The editor's base surface S (multires/base_surface.h): same connectivity, smooth points.
       LowPassFilter filter(loaded.mesh, {.smoothing = a->low_pass});
-      const Eigen::MatrixXd smooth = filter.apply(positions_matrix(loaded.mesh));
-      for (const VertexHandle v : loaded.mesh.vertices()) {
-        const auto r = smooth.row(v.idx());
-        loaded.mesh.set_point(v, Vec3(r[0], r[1], r[2]));
-      }
+      set_positions(loaded.mesh, filter.apply(positions_matrix(loaded.mesh)));
     }
     RemeshOptions options;
     options.target_length = a->length;

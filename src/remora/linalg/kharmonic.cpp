@@ -223,4 +223,15 @@ Eigen::MatrixXd positions_matrix(const Mesh& mesh) {
   return p;
 }
 
+void set_positions(Mesh& mesh, const Eigen::MatrixXd& positions) {
+  if (positions.rows() != static_cast<Eigen::Index>(mesh.n_vertices()) || positions.cols() != 3)
+    throw InvalidArgument("set_positions: " + std::to_string(positions.rows()) + " x " +
+                          std::to_string(positions.cols()) + " positions for a mesh of " +
+                          std::to_string(mesh.n_vertices()) + " vertices (n x 3 expected)");
+  for (auto v : mesh.all_vertices()) {
+    const auto r = positions.row(v.idx());
+    mesh.set_point(v, Vec3(r[0], r[1], r[2]));
+  }
+}
+
 } // namespace remora

@@ -82,7 +82,9 @@ struct KHarmonicSystem {
 KHarmonicSystem assemble_kharmonic(const Mesh& mesh, const Region& region,
                                    const KHarmonicOptions& options = {});
 
-/// The vertex positions as an n_vertices × 3 matrix, and back.
+/// The vertex positions as an n_vertices × 3 matrix (row = vertex idx), and back; set_positions
+/// throws InvalidArgument unless `positions` is n_vertices × 3.
 Eigen::MatrixXd positions_matrix(const Mesh& mesh);
+void set_positions(Mesh& mesh, const Eigen::MatrixXd& positions);
 
 } // namespace remora

@@ -200,10 +200,7 @@ Editor::Editor(Mesh mesh, EditorOptions options) : impl_(std::make_unique<Impl>(
   m.report.intrinsic_flips = m.filter->stats().laplacian_stats.flips;
   m.report.input_negative_weights = m.filter->stats().laplacian_stats.negative_before;
   Mesh s = m.input;
-  for (const VertexHandle v : s.vertices()) {
-    const auto r = smooth.row(v.idx());
-    s.set_point(v, Vec3(r[0], r[1], r[2]));
-  }
+  set_positions(s, smooth);
   m.report.milliseconds["base"] = ms_since(t0);
 
   // 3. The base B: the area-equalizing remesh of S, with the correspondence.
