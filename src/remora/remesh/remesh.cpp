@@ -562,14 +562,14 @@ private:
   }
 
   // Would moving `keep` to `p` (after removing `gone`) flip or collapse a face, or create an
-  // edge longer than 4/3 l?
-  bool collapse_is_safe(HalfedgeHandle h, const Vec3& p) {
+  // edge longer than √max_length2 (4/3 l in the cycles)?
+  bool collapse_is_safe(HalfedgeHandle h, const Vec3& p, double max_length2) {
     const VertexHandle gone = mesh_.from_vertex_handle(h), keep = mesh_.to_vertex_handle(h);
     const FaceHandle fl = mesh_.face_handle(h),
                      fr = mesh_.face_handle(mesh_.opposite_halfedge_handle(h));
     for (VertexHandle v : {gone, keep}) {
       for (auto w : mesh_.vv_range(v))
-        if (w != gone && w != keep && (mesh_.point(w) - p).sqrnorm() > hi2_) return false;
+        if (w != gone && w != keep && (mesh_.point(w) - p).sqrnorm() > max_length2) return false;
       for (auto f : mesh_.vf_range(v)) {
         if (f == fl || f == fr) continue;
         auto fv = face_vertices(mesh_, f);
@@ -588,6 +588,31 @@ private:
     return true;
   }
 
+  // Is the smallest angle of the faces around h's endpoints larger after collapsing h into p
+  // than before?
+  bool collapse_raises_min_angle(HalfedgeHandle h, const Vec3& p) const {
+    const VertexHandle gone = mesh_.from_vertex_handle(h), keep = mesh_.to_vertex_handle(h);
+    const FaceHandle fl = mesh_.face_handle(h),
+                     fr = mesh_.face_handle(mesh_.opposite_halfedge_handle(h));
+    double before = M_PI, after = M_PI;
+    auto smallest = [](const Vec3& a, const Vec3& b, const Vec3& c) {
+      const auto t = triangle_angles(a, b, c);
+      return std::min({t[0], t[1], t[2]});
+    };
+    for (VertexHandle v : {gone, keep})
+      for (auto f : mesh_.vf_range(v)) {
+        const auto fv = face_vertices(mesh_, f);
+        Vec3 q[3];
+        for (int k = 0; k < 3; ++k) q[k] = mesh_.point(fv[k]);
+        before = std::min(before, smallest(q[0], q[1], q[2]));
+        if (f == fl || f == fr) continue;
+        for (int k = 0; k < 3; ++k)
+          if (fv[k] == gone || fv[k] == keep) q[k] = p;
+        after = std::min(after, smallest(q[0], q[1], q[2]));
+      }
+    return after > before;
+  }
+
   std::size_t collapse_short_edges() {
     std::size_t count = 0;
     const std::size_t n = mesh_.n_edges();
@@ -600,10 +625,12 @@ private:
     return count;
   }
 
+  enum class Collapse { Short, Repair };
+
   // Collapses e if the rules allow it: corners never go, an interior vertex goes onto a boundary
   // vertex (which stays put), two boundary vertices merge along a boundary edge only, and the
   // result passes collapse_is_safe(). Otherwise the survivor moves to the midpoint.
-  bool try_collapse(EdgeHandle e) {
+  bool try_collapse(EdgeHandle e, Collapse purpose = Collapse::Short) {
     HalfedgeHandle h = mesh_.halfedge_handle(e, 0);
     VertexHandle a = mesh_.from_vertex_handle(h), b = mesh_.to_vertex_handle(h);
     const Kind ka = kind(a), kb = kind(b);
@@ -625,7 +652,12 @@ private:
       if (!collapse_keeps_manifold(h)) return false;
     }
     const Vec3 target = midpoint ? (mesh_.point(a) + mesh_.point(b)) * 0.5 : mesh_.point(b);
-    if (!collapse_is_safe(h, target)) return false;
+    if (purpose == Collapse::Short && !collapse_is_safe(h, target, hi2_)) return false;
+    // A repair may leave an edge up to √1.4 × 4/3 l ≈ 1.58 l long (one long edge costs the
+    // Laplacian less than a sliver), and must raise the smallest angle around it.
+    if (purpose == Collapse::Repair &&
+        !(collapse_is_safe(h, target, 1.4 * hi2_) && collapse_raises_min_angle(h, target)))
+      return false;
     live_faces_ -= mesh_.is_boundary(e) ? 1 : 2;
     mesh_.collapse(h);
     if (midpoint) mesh_.set_point(b, relocate(b, target, b));
@@ -637,6 +669,19 @@ private:
   // the pair, else collapse their shortest edge when the collapse rules allow. Sequential, in face
   // order; the mesh is compacted afterwards.
   std::size_t repair_bad_triangles(double min_deg) {
+    // Every repair raises the smallest angle of the faces it touches (up to the projection of a
+    // moved survivor), so passes do not undo each other; a pass that repairs nothing ends the
+    // loop, and three bound the work.
+    std::size_t total = 0;
+    for (int pass = 0; pass < 3; ++pass) {
+      const std::size_t c = repair_pass(min_deg);
+      total += c;
+      if (c == 0) break;
+    }
+    return total;
+  }
+  // One sweep of repair_bad_triangles().
+  std::size_t repair_pass(double min_deg) {
     const double min_rad = min_deg * M_PI / 180.0;
     std::size_t count = 0;
     auto min_angle = [&](VertexHandle x, VertexHandle y, VertexHandle z) {
@@ -672,7 +717,7 @@ private:
           continue;
         }
       }
-      if (try_collapse(mesh_.edge_handle(hs[shortest]))) ++count;
+      if (try_collapse(mesh_.edge_handle(hs[shortest]), Collapse::Repair)) ++count;
     }
     mesh_.garbage_collection();
     live_faces_ = mesh_.n_faces();
