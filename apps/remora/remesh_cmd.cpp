@@ -53,6 +53,9 @@ void print_remesh_report(std::ostream& os, const RemeshReport& r) {
       "{:>12.4f}{:>14.4f}{:>14.4f}");
   os << fmt::format("{:<28}{:>12.4f}{:>14.4f}{:>14.4f}\n", "Laplacian symmetry defect",
                     r.symmetry_defect_input, r.symmetry_defect_cycles, r.symmetry_defect_output);
+  if (r.symmetry_defect_output_interior != r.symmetry_defect_output)
+    os << fmt::format("{:<28}{:>12}{:>14}{:>14.4f}\n", "  without boundary rows", "", "",
+                      r.symmetry_defect_output_interior);
   os << fmt::format("distance to the input (of the bounding-box diagonal): vertices mean {:.2e} "
                     "max {:.2e}, face centroids mean {:.2e} max {:.2e}\n",
                     r.vertex_distance_mean, r.vertex_distance_max, r.centroid_distance_mean,

@@ -74,7 +74,7 @@ Eigen::SparseMatrix<double> cotan_weights(const Mesh& mesh) {
   return W;
 }
 
-double laplacian_symmetry_defect(const Mesh& mesh) {
+double laplacian_symmetry_defect(const Mesh& mesh, SymmetryRows rows) {
   const std::vector<double> weights = edge_weights(mesh);
   const Eigen::VectorXd areas = vertex_areas_mixed(mesh);
   // Per row of W: the diagonal and the sum of the squared off-diagonal entries.
@@ -92,8 +92,11 @@ double laplacian_symmetry_defect(const Mesh& mesh) {
   }
   double area_sum = 0.0;
   std::size_t counted = 0;
+  const auto counts = [&](VertexHandle v) {
+    return !mesh.is_isolated(v) && (rows == SymmetryRows::All || !mesh.is_boundary(v));
+  };
   for (const VertexHandle v : mesh.vertices()) {
-    if (mesh.is_isolated(v)) continue;
+    if (!counts(v)) continue;
     area_sum += areas[v.idx()];
     ++counted;
   }
@@ -105,7 +108,7 @@ double laplacian_symmetry_defect(const Mesh& mesh) {
   double norm = 0.0;
   for (const VertexHandle v : mesh.vertices()) {
     const double a = areas[v.idx()];
-    if (mesh.is_isolated(v) || !(a > 0.0)) continue;
+    if (!counts(v) || !(a > 0.0)) continue;
     const double row = squares[v.idx()] + diagonal[v.idx()] * diagonal[v.idx()];
     const double scale = (mean - a) / (a * mean);
     difference += row * scale * scale;

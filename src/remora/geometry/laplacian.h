@@ -34,6 +34,13 @@ Eigen::SparseMatrix<double> cotan_weights(const Mesh& mesh);
 /// W including its diagonal. Computed in O(V + E) without forming either matrix. Scale-invariant;
 /// 0 when all mixed areas are equal. Rows of vertices with zero mixed area (all their faces have
 /// zero area) are left out, since A^-1 W is undefined there; returns 0 when nothing is left.
-double laplacian_symmetry_defect(const Mesh& mesh);
+///
+/// `SymmetryRows::Interior` leaves out the rows of mesh-boundary vertices, from the mean too. On an
+/// open mesh those rows cannot match: a boundary vertex of a well-shaped mesh has about half an
+/// interior vertex's area (its triangles span π, not 2π), so they alone put the full defect near
+/// 0.08–0.15 however equal the interior is. The interior figure is what a support away from the
+/// mesh boundary sees (docs/remesh.md).
+enum class SymmetryRows { All, Interior };
+double laplacian_symmetry_defect(const Mesh& mesh, SymmetryRows rows = SymmetryRows::All);
 
 } // namespace remora

@@ -114,6 +114,8 @@ public:
       timed("report", [&] {
         report.after_equalization = mesh_quality(mesh_);
         report.symmetry_defect_output = laplacian_symmetry_defect(mesh_);
+        report.symmetry_defect_output_interior =
+            laplacian_symmetry_defect(mesh_, SymmetryRows::Interior);
         measure_distances(report);
       });
 
@@ -1044,7 +1046,8 @@ nlohmann::json to_json(const RemeshReport& r) {
           {"symmetry_defect",
            {{"input", r.symmetry_defect_input},
             {"after_cycles", r.symmetry_defect_cycles},
-            {"output", r.symmetry_defect_output}}},
+            {"output", r.symmetry_defect_output},
+            {"output_interior_rows", r.symmetry_defect_output_interior}}},
           {"distance_to_input",
            {{"vertex_mean", r.vertex_distance_mean},
             {"vertex_max", r.vertex_distance_max},

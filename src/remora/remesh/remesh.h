@@ -68,6 +68,9 @@ struct RemeshReport {
   double symmetry_defect_input = 0.0; ///< laplacian_symmetry_defect() of the input
   double symmetry_defect_cycles = 0.0;
   double symmetry_defect_output = 0.0;
+  /// The same without the rows of mesh-boundary vertices (SymmetryRows::Interior); equal to the
+  /// above on a closed mesh.
+  double symmetry_defect_output_interior = 0.0;
   /// Distances of the output to the input, relative to the input's bounding-box diagonal: of the
   /// output vertices (0 when projecting) and of the output faces' centroids (the chord error).
   double vertex_distance_mean = 0.0, vertex_distance_max = 0.0;
