@@ -8,7 +8,7 @@
 //                       [--write-dir DIR] [mesh files...]
 //
 // Without files: the CI meshes of ../shared/data/MANIFEST.md that load as manifolds (plus
-// derived/igea_sub4.ply with --large). l = 0.9 x the loaded mesh's mean edge length, as remesh()
+// derived/igea_sub4.ply with --large). l = 0.9 x the loaded mesh's length scale (its mean edge length unless needles inflate it), as remesh()
 // computes it; 5 cycles. Ours runs twice per round: default options (5 cycles + the default 10
 // equalization iterations) and cycles only (equalize_iterations = 0, the like-for-like comparison). CGAL keeps
 // the mesh boundary by default: boundary edges are split at midpoints and collapsed onto boundary
@@ -255,7 +255,7 @@ void race(MeshRace& r, const Args& args) {
   r.input_faces = input.n_faces();
   r.input_vertices = input.n_vertices();
   r.input_boundary_loops = remora::mesh_quality(input).boundary_loops;
-  const double l = kLengthFactor * remora::mean_edge_length(input);
+  const double l = kLengthFactor * remora::length_scale(input).length; // the default l
   r.target_length = l;
 
   remora::RemeshOptions eq_options;
@@ -406,7 +406,7 @@ void print_race(const MeshRace& r, int repeat) {
     fmt::print("## {}: error: {}\n\n", r.name, r.error);
     return;
   }
-  fmt::print("## {} ({} faces, {} boundary loops), l = {:.6g} (0.9 x mean edge), {} cycles, "
+  fmt::print("## {} ({} faces, {} boundary loops), l = {:.6g} (0.9 x length scale), {} cycles, "
              "best of {}\n\n",
              r.name, r.input_faces, r.input_boundary_loops, r.target_length, kCycles, repeat);
   fmt::print("| variant | faces out | wall ms | CPU ms | wall us/tri | CPU us/tri | min angle | "

@@ -105,6 +105,33 @@ TEST(MeasuresEdges, MeanEdgeLength) {
   EXPECT_EQ(mean_edge_length(Mesh()), 0.0);
 }
 
+TEST(MeasuresEdges, LengthScaleIgnoresNeedles) {
+  // Well shaped: the mean edge length, and the area-based length agrees within 15 % (the grid's
+  // boundary vertices carry less area).
+  Mesh grid = make_equilateral_grid(20, 20, 0.3);
+  LengthScale scale = length_scale(grid);
+  EXPECT_FALSE(scale.needles);
+  EXPECT_NEAR(scale.length, 0.3, 1e-12);
+  EXPECT_NEAR(scale.from_area, 0.3, 0.15 * 0.3);
+  // Squeezed 8x across: needles whose long edges keep the mean edge length at 0.2 while the area
+  // per vertex is an eighth; the area-based length √(2A / (√3 V)) = 0.3 / √8 takes over.
+  for (auto v : grid.vertices()) {
+    Vec3 p = grid.point(v);
+    p[1] /= 8.0;
+    grid.set_point(v, p);
+  }
+  scale = length_scale(grid);
+  EXPECT_TRUE(scale.needles);
+  EXPECT_NEAR(scale.mean_edge, mean_edge_length(grid), 1e-15);
+  EXPECT_NEAR(scale.from_area,
+              std::sqrt(2.0 * surface_area(grid) /
+                        (std::sqrt(3.0) * static_cast<double>(grid.n_vertices()))),
+              1e-12);
+  EXPECT_NEAR(scale.from_area, 0.3 / std::sqrt(8.0), 0.15 * 0.3 / std::sqrt(8.0));
+  EXPECT_EQ(scale.length, scale.from_area);
+  EXPECT_EQ(length_scale(Mesh()).length, 0.0);
+}
+
 TEST(MeasuresTriangle, AreaOfHandComputedTriangles) {
   EXPECT_DOUBLE_EQ(triangle_area(Vec3(0, 0, 0), Vec3(4, 0, 0), Vec3(0, 3, 0)), 6.0);
   // (b - a) x (c - a) = (3, 4, 0) x (0, 0, 5) = (20, -15, 0): |.| / 2 = 12.5.

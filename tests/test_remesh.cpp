@@ -107,6 +107,31 @@ TEST(Remesh, FlatGridWithNeedlesBecomesIsotropic) {
   EXPECT_LT(r.report.after_equalization.angles.percent_below_30, 1.0);
 }
 
+TEST(Remesh, DefaultLengthFollowsTheAreaOnNeedles) {
+  // An equilateral grid squeezed 8x across: every triangle a needle.
+  Mesh needles = make_equilateral_grid(20, 20, 0.3);
+  for (auto v : needles.vertices()) {
+    Vec3 p = needles.point(v);
+    p[1] /= 8.0;
+    needles.set_point(v, p);
+  }
+  const LengthScale scale = length_scale(needles);
+  ASSERT_TRUE(scale.needles);
+  RemeshOptions opt;
+  opt.equalize_iterations = 0;
+  RemeshResult r = remesh(needles, opt);
+  EXPECT_TRUE(r.report.length_from_area);
+  EXPECT_DOUBLE_EQ(r.report.target_length, 0.9 * scale.from_area);
+  opt.target_length = 0.05; // an explicit length is taken as given
+  r = remesh(needles, opt);
+  EXPECT_FALSE(r.report.length_from_area);
+  EXPECT_EQ(r.report.target_length, 0.05);
+  const Mesh sphere = make_icosphere(3);
+  r = remesh(sphere, RemeshOptions{});
+  EXPECT_FALSE(r.report.length_from_area);
+  EXPECT_DOUBLE_EQ(r.report.target_length, 0.9 * mean_edge_length(sphere));
+}
+
 TEST(Remesh, KeepsTheBoundaryAndItsCorners) {
   const Mesh input = make_grid(30, 30, 3.0, 3.0);
   RemeshOptions opt;
@@ -365,6 +390,7 @@ TEST_P(RemeshUglyData, RepairsNeverLowerTheSmallestAngle) {
   if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " not present";
   const Mesh input = read_mesh(path).mesh;
   RemeshOptions options;
+  options.target_length = 0.9 * mean_edge_length(input); // the paper's l, needles or not
   options.project = false;
   options.equalize_iterations = 0;
   options.repair_angle_deg = 0.0;

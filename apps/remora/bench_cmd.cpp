@@ -93,7 +93,7 @@ void add_bench_command(CLI::App& app) {
       ->check(CLI::PositiveNumber);
   cmd->add_flag("--no-remesh", a->no_remesh, "Solve on the mesh as loaded");
   cmd->add_option("--length-factor", a->length_factor,
-                  "Remesh at this factor × the mean edge length (default 0.9; 0.65 doubles the "
+                  "Remesh at this factor × the length scale (default 0.9; 0.65 doubles the "
                   "vertex count, for supports of ~1M free vertices on igea_sub4)")
       ->check(CLI::Range(0.1, 10.0));
   cmd->add_flag("--json", a->json, "Print one JSON object");

@@ -169,10 +169,12 @@ void add_edit_command(CLI::App& app) {
   cmd->add_option("--details", a->details, "normal (default, Phong), displacement, none")
       ->check(CLI::IsMember({"normal", "displacement", "none"}));
   cmd->add_option("--base-smoothing", a->base_smoothing,
-                  "Low-pass length of the base surface, in mean edge lengths (default 2)")
+                  "Low-pass length of the base surface, in mean edge lengths (area-based on needle "
+                  "meshes; default 2)")
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--length-factor", a->length_factor,
-                  "Base remesh edge length = factor x the mean edge length (default 0.9)")
+                  "Base remesh edge length = factor x the mean edge length (area-based on needle "
+                  "meshes; default 0.9)")
       ->check(CLI::PositiveNumber);
   cmd->add_flag("--no-remesh", a->no_remesh,
                 "Solve on the input's own connectivity (the baseline the paper improves on)");

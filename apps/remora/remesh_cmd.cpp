@@ -17,7 +17,10 @@ namespace remora::cli {
 namespace {
 
 void print_remesh_report(std::ostream& os, const RemeshReport& r) {
-  os << fmt::format("target edge length l = {:.6g}\n", r.target_length);
+  os << fmt::format("target edge length l = {:.6g}{}\n", r.target_length,
+                    r.length_from_area ? " (from the area per vertex: needles inflate the mean "
+                                         "edge length)"
+                                       : "");
   os << fmt::format("{:<28}{:>12}{:>14}{:>14}\n", "", "input", "after cycles", "equalized");
   auto line = [&](const char* label, auto get, const char* fmt_spec) {
     os << fmt::format("{:<28}", label)
@@ -87,8 +90,9 @@ void add_remesh_command(CLI::App& app) {
       ->required();
   auto* length = cmd->add_option("--length", a->length, "Target edge length l (absolute)")
                      ->check(CLI::PositiveNumber);
-  cmd->add_option("--length-factor", a->factor,
-                  "l = factor x the input's mean edge length (default 0.9)")
+  cmd->add_option(
+         "--length-factor", a->factor,
+         "l = factor x the input's mean edge length, area-based on needle meshes (default 0.9)")
       ->check(CLI::PositiveNumber)
       ->excludes(length);
   cmd->add_option("--cycles", a->cycles, "Split/collapse/flip/smooth cycles (default 5)")

@@ -150,4 +150,21 @@ double mean_edge_length(const Mesh& mesh) {
   return n > 0 ? sum / static_cast<double>(n) : 0.0;
 }
 
+LengthScale length_scale(const Mesh& mesh) {
+  LengthScale scale;
+  scale.mean_edge = mean_edge_length(mesh);
+  scale.length = scale.mean_edge;
+  std::size_t used = 0;
+  for (auto v : mesh.vertices())
+    if (!mesh.is_isolated(v)) ++used;
+  const double area = surface_area(mesh);
+  if (used == 0 || !(area > 0.0)) return scale;
+  scale.from_area = std::sqrt(2.0 * area / (std::sqrt(3.0) * static_cast<double>(used)));
+  if (scale.from_area < 0.75 * scale.mean_edge) {
+    scale.length = scale.from_area;
+    scale.needles = true;
+  }
+  return scale;
+}
+
 } // namespace remora

@@ -49,9 +49,21 @@ Eigen::VectorXd vertex_areas_mixed(const Mesh& mesh);
 
 /// Axis-aligned bounding box of all non-deleted vertices (isolated ones included). A mesh without
 /// vertices gives min = max = (0, 0, 0).
-/// Mean length of the mesh's edges (0 for a mesh without edges). remesh() derives its default
-/// target length from it.
+/// Mean length of the mesh's edges (0 for a mesh without edges).
 double mean_edge_length(const Mesh& mesh);
+
+/// The mesh's length scale, from which remesh() derives its default target length and the
+/// base-surface filter its σ: the mean edge length, unless needles inflate it. The edge length
+/// of equilateral triangles with the mesh's area per (non-isolated) vertex, √(2A / (√3 V)), is
+/// within about 15 % of the mean edge length on a well-shaped mesh; when it is below 3/4 of it
+/// (every triangle of cad/blade.off is a needle: 0.46; cad/featuretype.STL 0.61), it is used.
+struct LengthScale {
+  double length = 0.0;
+  double mean_edge = 0.0;
+  double from_area = 0.0;
+  bool needles = false; ///< from_area was used
+};
+LengthScale length_scale(const Mesh& mesh);
 
 struct BoundingBox {
   Vec3 min{0.0, 0.0, 0.0};

@@ -19,7 +19,7 @@ LowPassFilter::LowPassFilter(const Mesh& mesh, const LowPassOptions& options)
     throw InvalidArgument(fmt::format(
         "low-pass filter: smoothing {} must be finite and >= 0, steps {} >= 1, tolerance {} > 0",
         options.smoothing, options.steps, options.tolerance));
-  stats_.sigma = options.smoothing * mean_edge_length(mesh);
+  stats_.sigma = options.smoothing * length_scale(mesh).length;
   if (!(stats_.sigma > 0.0)) return; // identity
   IntrinsicLaplacian lap = intrinsic_delaunay_laplacian(mesh);
   mass_ = std::move(lap.mass);

@@ -5,7 +5,8 @@
 // needles and zero-area faces, where the mesh's own cotan weights are huge or negative and would
 // make the system indefinite; docs/editing.md says why this choice and what it measured.
 //
-// Strength: t = σ², σ = smoothing × the mesh's mean edge length. A Laplacian eigenfunction of
+// Strength: t = σ², σ = smoothing × the mesh's length scale (its mean edge length unless needles
+// inflate it: geometry/measures.h, length_scale()). A Laplacian eigenfunction of
 // wavelength λ is scaled by 1 / (1 + (2πσ/λ)²) per step: wavelengths below 2πσ lose at least half.
 // The filter is factored once (a Jacobi-preconditioned CG set-up) and applied to any positions.
 #pragma once
@@ -22,7 +23,8 @@
 namespace remora {
 
 struct LowPassOptions {
-  /// σ in units of the mean edge length; 0 turns the filter into the identity.
+  /// σ in units of length_scale() (the mean edge length on a mesh without needles); 0 turns the
+  /// filter into the identity.
   double smoothing = 2.0;
   /// Implicit steps with the same operator (a steeper cut-off).
   int steps = 1;

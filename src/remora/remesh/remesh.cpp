@@ -61,8 +61,10 @@ public:
       f();
       report.milliseconds[phase] += ms_since(t0);
     };
-    const double mean = mean_edge_length(input_);
-    length_ = options_.target_length > 0 ? options_.target_length : options_.length_factor * mean;
+    const LengthScale scale = length_scale(input_);
+    length_ =
+        options_.target_length > 0 ? options_.target_length : options_.length_factor * scale.length;
+    report.length_from_area = options_.target_length <= 0 && scale.needles;
     if (!std::isfinite(length_) || length_ <= 0)
       throw InvalidArgument("remesh: the target edge length must be positive and finite (got " +
                             std::to_string(length_) + ")");
@@ -1040,6 +1042,7 @@ RemeshResult remesh(const Mesh& input, const RemeshOptions& options) {
 
 nlohmann::json to_json(const RemeshReport& r) {
   return {{"target_length", r.target_length},
+          {"length_from_area", r.length_from_area},
           {"input", to_json(r.input)},
           {"after_cycles", to_json(r.after_cycles)},
           {"after_equalization", to_json(r.after_equalization)},

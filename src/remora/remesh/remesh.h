@@ -31,7 +31,8 @@ enum class Equalization {
 
 struct RemeshOptions {
   /// Absolute target edge length l; when <= 0, l = length_factor × the input's mean edge length
-  /// (the paper: "slightly less than the average").
+  /// (the paper: "slightly less than the average"), or × its area-based length when needles
+  /// inflate the mean (length_scale() in geometry/measures.h).
   double target_length = 0.0;
   double length_factor = 0.9;
   /// Cycles of split (> 4/3 l), collapse (< 4/5 l), valence flips, tangential smoothing.
@@ -62,6 +63,7 @@ struct RemeshOptions {
 
 struct RemeshReport {
   double target_length = 0.0;
+  bool length_from_area = false; ///< l came from the area per vertex (a needle-ridden input)
   MeshQuality input;
   MeshQuality after_cycles;
   MeshQuality after_equalization;
