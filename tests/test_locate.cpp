@@ -324,6 +324,40 @@ TEST(ClosestPointTriangle, VertexOrderDoesNotMatter) {
   }
 }
 
+// The plane projection's barycentrics reproduce the foot of the perpendicular, agree with the
+// closest point inside the triangle, and name the edge the foot falls beyond outside it.
+TEST(PlaneBarycentrics, ReproduceTheFootOfThePerpendicular) {
+  std::mt19937 rng(29);
+  for (int trial = 0; trial < 2000; ++trial) {
+    const Vec3 a = random_vector(rng, 1.0), b = random_vector(rng, 1.0),
+               c = random_vector(rng, 1.0), p = random_vector(rng, 2.0);
+    std::array<double, 3> w{};
+    ASSERT_TRUE(plane_barycentrics(p, a, b, c, w));
+    EXPECT_NEAR(w[0] + w[1] + w[2], 1.0, 1e-12);
+    const Vec3 foot = a * w[0] + b * w[1] + c * w[2];
+    const Vec3 n = OpenMesh::cross(b - a, c - a).normalized();
+    // p - foot is normal to the plane.
+    EXPECT_LE((p - foot - n * OpenMesh::dot(p - foot, n)).norm(), 1e-9) << trial;
+    const TriangleClosest r = closest_point_on_triangle(p, a, b, c);
+    if (std::min({w[0], w[1], w[2]}) > 1e-9) {
+      EXPECT_LE((r.point - foot).norm(), 1e-9) << trial;
+    } else {
+      EXPECT_GT(r.distance2, (p - foot).sqrnorm() - 1e-12) << trial;
+    }
+  }
+  std::array<double, 3> w{};
+  // Beyond the edge bc (opposite a): the weight of a is negative.
+  ASSERT_TRUE(plane_barycentrics(Vec3(1, 1, 0.5), Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), w));
+  EXPECT_NEAR(w[0], -1.0, 1e-15);
+  EXPECT_NEAR(w[1], 1.0, 1e-15);
+  EXPECT_NEAR(w[2], 1.0, 1e-15);
+  const std::array<double, 3> untouched{7, 8, 9};
+  w = untouched;
+  EXPECT_FALSE(plane_barycentrics(Vec3(1, 1, 1), Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(2, 0, 0), w));
+  EXPECT_FALSE(plane_barycentrics(Vec3(1, 1, 1), Vec3(0, 0, 0), Vec3(0, 0, 0), Vec3(0, 0, 0), w));
+  EXPECT_EQ(w, untouched);
+}
+
 // ---------------------------------------------------------------------------------------------
 // Walking to the closest point on a mesh
 

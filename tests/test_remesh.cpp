@@ -234,6 +234,22 @@ TEST(Remesh, InputVerticesFindTheirClosestOutputPoint) {
   }
 }
 
+// The input -> output locations are carried through every split, collapse, flip and move (not
+// searched for at the end): the final walk that makes each one the input vertex's closest point
+// on the output finds them all but exact already. Dropping the update after the moves, or the
+// redistribution after a split or collapse, leaves them far behind.
+TEST(Remesh, TracksInputVerticesThroughEveryOperation) {
+  for (int shape = 0; shape < 2; ++shape) {
+    const Mesh input = shape == 0 ? make_icosphere(4) : needle_grid();
+    RemeshOptions opt;
+    opt.target_length = shape == 0 ? 0.15 : 0.12;
+    const RemeshReport rep = remesh(input, opt).report;
+    EXPECT_GT(rep.tracked_same_face, 0.97) << "shape " << shape;
+    EXPECT_LT(rep.tracked_excess_mean, 1e-4) << "shape " << shape;
+    EXPECT_LT(rep.tracked_excess_max, 0.05) << "shape " << shape;
+  }
+}
+
 TEST(Remesh, IsDeterministicWhateverTheThreadCount) {
   const Mesh input = needle_grid();
   RemeshOptions one;
@@ -326,6 +342,9 @@ void expect_papers_area_figures(const RemeshResult& r, SymmetryRows rows) {
                                       : rep.symmetry_defect_output_interior,
             0.06);
   EXPECT_GT(fraction_in_band(r.mesh, rep.target_length), 0.95);
+  // The tracked input -> output locations are (all but) the closest points already.
+  EXPECT_LT(rep.tracked_excess_mean, 1e-3);
+  EXPECT_LT(rep.tracked_excess_max, 0.25);
 }
 
 // The paper's claims on real closed meshes of ../shared/data (skipped when absent).
@@ -386,6 +405,7 @@ TEST_P(RemeshUglyData, GivesASoundMesh) {
   EXPECT_EQ(boundary_loops(r.mesh).size(), boundary_loops(input).size());
   EXPECT_LT(r.report.after_equalization.mixed_area.rel_mad,
             r.report.after_cycles.mixed_area.rel_mad);
+  EXPECT_LT(r.report.tracked_excess_mean, 0.01);
 }
 
 // Every repair (a flip or a collapse) must raise the smallest angle of the faces it touches. With

@@ -63,6 +63,9 @@ void print_remesh_report(std::ostream& os, const RemeshReport& r) {
                     "max {:.2e}, face centroids mean {:.2e} max {:.2e}\n",
                     r.vertex_distance_mean, r.vertex_distance_max, r.centroid_distance_mean,
                     r.centroid_distance_max);
+  os << fmt::format("input -> output locations, tracked through every operation: farther than "
+                    "the closest point by {:.1e} l on average, {:.1e} l at most\n",
+                    r.tracked_excess_mean, r.tracked_excess_max);
   os << fmt::format("operations: {} splits, {} collapses, {} flips, {} repairs\n",
                     grouped(r.splits), grouped(r.collapses), grouped(r.flips), grouped(r.repairs));
   std::string times;

@@ -112,4 +112,19 @@ TriangleClosest closest_point_on_triangle(const Vec3& p, const Vec3& a, const Ve
   return on_edges(p, a, b, c);
 }
 
+bool plane_barycentrics(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c,
+                        std::array<double, 3>& bary) {
+  const Vec3 ab = b - a, ac = c - a;
+  const Vec3 n = OpenMesh::cross(ab, ac);
+  const double nn = OpenMesh::dot(n, n);
+  const double scale = ab.sqrnorm() + ac.sqrnorm();
+  if (!(nn > 1e-24 * scale * scale)) return false;
+  const Vec3 ap = p - a;
+  // Signed sub-areas against the normal: the weight of b is the area of (a, p, c), of c (a, b, p).
+  const double wb = OpenMesh::dot(OpenMesh::cross(ap, ac), n) / nn;
+  const double wc = OpenMesh::dot(OpenMesh::cross(ab, ap), n) / nn;
+  bary = {1.0 - wb - wc, wb, wc};
+  return true;
+}
+
 } // namespace remora

@@ -42,4 +42,12 @@ struct TriangleClosest {
 TriangleClosest closest_point_on_triangle(const Vec3& p, const Vec3& a, const Vec3& b,
                                           const Vec3& c);
 
+/// Barycentric coordinates (summing to 1) of the orthogonal projection of p onto the plane of
+/// (a, b, c): all >= 0 when it falls in the triangle, the most negative one names the edge it
+/// falls beyond (the edge opposite that corner). A few dot products, for walks that step across
+/// edges; false (bary untouched) for a triangle whose doubled area is <= 1e-12 (sum of its two
+/// edges from a, squared).
+bool plane_barycentrics(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c,
+                        std::array<double, 3>& bary);
+
 } // namespace remora

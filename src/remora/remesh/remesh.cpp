@@ -41,14 +41,17 @@ enum class Kind : std::uint8_t {
   Corner,   // never moves (a sharp boundary corner)
 };
 
+// The first input vertex located on an output face (the head of a list through Remesher::next_).
+struct PointList {
+  int head = -1;
+};
+
 class Remesher {
 public:
   Remesher(const Mesh& input, const RemeshOptions& options)
       : input_(input), options_(options), mesh_(input) {
     // Working properties of the private copy; removed before the mesh is handed out.
-    mesh_.add_property(loc_prop_);
-    mesh_.add_property(bloc_prop_);
-    mesh_.add_property(kind_prop_);
+    add_working_properties();
   }
 
   RemeshResult run() {
@@ -88,6 +91,7 @@ public:
       });
 
     init_locations();
+    init_points();
     for (int cycle = 0; cycle < options_.cycles; ++cycle) {
       progress("remesh", cycle, options_.cycles);
       timed("split", [&] { report.splits += split_long_edges(); });
@@ -125,12 +129,14 @@ public:
       progress("correspondence", 0, 1);
       result.output_on_input.resize(mesh_.n_vertices());
       for (auto v : mesh_.vertices()) result.output_on_input[v.idx()] = loc(v);
-      result.input_on_output = locate_input_vertices();
+      reproject_points(); // the repair changed faces after the last moves
+      result.input_on_output = closest_input_locations(report);
     });
 
     mesh_.remove_property(loc_prop_);
     mesh_.remove_property(bloc_prop_);
     mesh_.remove_property(kind_prop_);
+    mesh_.remove_property(points_prop_);
     result.mesh = std::move(mesh_);
     report.milliseconds["total"] = ms_since(t_total);
     return result;
@@ -279,6 +285,7 @@ private:
       reorder_spatially();
     else
       mesh_.garbage_collection();
+    rebind_points();
     live_faces_ = mesh_.n_faces();
   }
 
@@ -378,6 +385,8 @@ private:
         if (f.is_valid())
           out.set_face_handle(hn, FaceHandle(fmap[static_cast<std::size_t>(f.idx())]));
       }
+    std::vector<PointList> lists(nf);
+    for (std::size_t r = 0; r < nf; ++r) lists[r] = points(FaceHandle(face_order[r]));
     std::vector<SurfacePoint> locs(nv);
     std::vector<HalfedgeHandle> blocs(nv);
     std::vector<Kind> kinds(nv);
@@ -390,15 +399,14 @@ private:
       kinds[r] = kind(v);
     }
     mesh_ = std::move(out);
-    mesh_.add_property(loc_prop_);
-    mesh_.add_property(bloc_prop_);
-    mesh_.add_property(kind_prop_);
+    add_working_properties();
     for (std::size_t r = 0; r < nv; ++r) {
       const VertexHandle v(static_cast<int>(r));
       loc(v) = locs[r];
       bloc(v) = blocs[r];
       kind(v) = kinds[r];
     }
+    for (std::size_t r = 0; r < nf; ++r) points(FaceHandle(static_cast<int>(r))) = lists[r];
     live_faces_ = mesh_.n_faces();
   }
 
@@ -453,39 +461,174 @@ private:
     return best_face;
   }
 
-  // Each input vertex's closest point on the output, found by a local walk from the face the
-  // input vertex's own location points to through the output's tracked vertex locations: the
-  // output vertex nearest in index space is not known, so the walk starts from a face around the
-  // output vertex whose input location shares the input vertex's face.
-  std::vector<SurfacePoint> locate_input_vertices() {
-    // Seed: for each input face, an output vertex located in it (any).
-    std::vector<int> seed(input_.n_faces(), -1);
-    for (auto v : mesh_.vertices())
-      if (!mesh_.is_isolated(v)) seed[loc(v).face.idx()] = v.idx();
-    // Spread seeds to faces without one, breadth-first over input face adjacency, so every input
-    // face knows a nearby output vertex.
-    std::vector<int> queue;
-    for (auto f : input_.faces())
-      if (seed[f.idx()] >= 0) queue.push_back(f.idx());
-    for (std::size_t q = 0; q < queue.size(); ++q) {
-      const FaceHandle f(queue[q]);
-      for (auto g : input_.ff_range(f))
-        if (seed[g.idx()] < 0) {
-          seed[g.idx()] = seed[f.idx()];
-          queue.push_back(g.idx());
-        }
+  // --- input -> output: every input vertex on a face of the working mesh ------------------
+  //
+  // Each input vertex i has a location track_[i] (an output face and barycentrics), and each
+  // output face lists the input vertices located on it: a doubly linked list through next_/prev_
+  // whose head is a face property, so that it follows the faces through garbage collection and an
+  // operation finds the input vertices it displaces without a search. Every operation keeps each
+  // input vertex on a live face next to it: a split and a flip keep their faces (an input vertex
+  // stays on the half or the new triangle of its old face, at most one face from where it lies),
+  // a collapse puts the input vertices of its two deleted faces on the closest face around the
+  // survivor. After each pass of vertex moves (tangential smoothing, every equalization step)
+  // and before the end, each input vertex is projected again by a walk across the edges its
+  // projection falls beyond (reproject_points). At the very end one last walk makes each
+  // location the input vertex's closest point on the output.
+
+  PointList& points(FaceHandle f) { return mesh_.property(points_prop_, f); }
+
+  void link_point(int i, FaceHandle f) {
+    PointList& list = points(f);
+    const auto u = static_cast<std::size_t>(i);
+    prev_[u] = -1;
+    next_[u] = list.head;
+    if (list.head >= 0) prev_[static_cast<std::size_t>(list.head)] = i;
+    list.head = i;
+    track_[u].face = f;
+  }
+
+  void unlink_point(int i) {
+    const auto u = static_cast<std::size_t>(i);
+    if (prev_[u] >= 0)
+      next_[static_cast<std::size_t>(prev_[u])] = next_[u];
+    else
+      points(track_[u].face).head = next_[u];
+    if (next_[u] >= 0) prev_[static_cast<std::size_t>(next_[u])] = prev_[u];
+  }
+
+  // Takes every input vertex off face f and appends it to `out`.
+  void take_points(FaceHandle f, std::vector<int>& out) {
+    PointList& list = points(f);
+    for (int i = list.head; i >= 0; i = next_[static_cast<std::size_t>(i)]) out.push_back(i);
+    list.head = -1;
+  }
+
+  // Puts every input vertex of `taken` on the closest of the faces around v, and clears `taken`.
+  void place_points_around(VertexHandle v, std::vector<int>& taken) {
+    if (taken.empty()) return;
+    FaceHandle faces[64];
+    std::array<Vec3, 3> corners[64];
+    int n = 0;
+    for (auto f : mesh_.vf_range(v)) {
+      if (n == 64) break;
+      const auto fv = face_vertices(mesh_, f);
+      faces[n] = f;
+      corners[n] = {mesh_.point(fv[0]), mesh_.point(fv[1]), mesh_.point(fv[2])};
+      ++n;
     }
-    std::vector<SurfacePoint> out(input_.n_vertices());
-    parallel_for(input_.n_vertices(), options_.threads, [&](std::size_t i) {
-      const VertexHandle vi(static_cast<int>(i));
-      if (input_.is_isolated(vi)) return;
-      const FaceHandle fi = *input_.cvf_begin(vi);
-      const int s = seed[fi.idx()];
-      if (s < 0) return;
-      const VertexHandle vo(s);
-      const FaceHandle start = *mesh_.cvf_begin(vo);
-      out[i] = walk_to_closest(mesh_, input_.point(vi), start, 256);
+    for (int i : taken) {
+      const Vec3 q = input_.point(VertexHandle(i));
+      double best = std::numeric_limits<double>::infinity();
+      int best_k = 0;
+      std::array<double, 3> bary{1.0, 0.0, 0.0};
+      for (int k = 0; k < n; ++k) {
+        const TriangleClosest c =
+            closest_point_on_triangle(q, corners[k][0], corners[k][1], corners[k][2]);
+        if (c.distance2 < best) {
+          best = c.distance2;
+          best_k = k;
+          bary = c.bary;
+        }
+      }
+      link_point(i, faces[best_k]);
+      track_[static_cast<std::size_t>(i)].bary = bary;
+    }
+    taken.clear();
+  }
+
+  // Every input vertex starts at its own output vertex (the working mesh is a copy of the input).
+  void init_points() {
+    const std::size_t n = input_.n_vertices();
+    track_.assign(n, SurfacePoint());
+    next_.assign(n, -1);
+    prev_.assign(n, -1);
+    for (auto v : input_.vertices()) {
+      if (input_.is_isolated(v)) continue;
+      const FaceHandle f = *mesh_.cvf_begin(v);
+      const auto fv = face_vertices(mesh_, f);
+      link_point(v.idx(), f);
+      track_[static_cast<std::size_t>(v.idx())].bary = {
+          fv[0] == v ? 1.0 : 0.0, fv[1] == v ? 1.0 : 0.0, fv[2] == v ? 1.0 : 0.0};
+    }
+  }
+
+  // After garbage collection or renumbering the faces have new handles; the lists moved with
+  // them, so each input vertex takes its face from the list it is on.
+  void rebind_points() {
+    for (auto f : mesh_.faces())
+      for (int i = points(f).head; i >= 0; i = next_[static_cast<std::size_t>(i)])
+        track_[static_cast<std::size_t>(i)].face = f;
+  }
+
+  // Projects every input vertex onto its face again after vertices moved or faces changed: a
+  // visibility walk that steps across the edge its projection falls beyond until the projection
+  // lies in the face (almost always at once, or after one step). Where that stops at the
+  // boundary, or turns in a circle on a strongly curved part, a short closest-point walk takes
+  // over. Data-parallel, then the lists are updated in input order.
+  void reproject_points() {
+    const std::size_t n = track_.size();
+    std::vector<SurfacePoint> moved(n);
+    parallel_for(n, options_.threads, [&](std::size_t i) {
+      if (!track_[i].face.is_valid()) return;
+      const Vec3 q = input_.point(VertexHandle(static_cast<int>(i)));
+      FaceHandle f = track_[i].face;
+      for (int step = 0; step < 8; ++step) {
+        const HalfedgeHandle h0 = mesh_.halfedge_handle(f);
+        const HalfedgeHandle h1 = mesh_.next_halfedge_handle(h0);
+        const HalfedgeHandle h2 = mesh_.next_halfedge_handle(h1);
+        std::array<double, 3> w{};
+        if (!plane_barycentrics(q, mesh_.point(mesh_.from_vertex_handle(h0)),
+                                mesh_.point(mesh_.to_vertex_handle(h0)),
+                                mesh_.point(mesh_.to_vertex_handle(h1)), w))
+          break;
+        const int k = static_cast<int>(std::min_element(w.begin(), w.end()) - w.begin());
+        if (w[static_cast<std::size_t>(k)] >= 0) {
+          moved[i] = SurfacePoint{f, w};
+          return;
+        }
+        // The edge opposite corner k: h1 for corner 0, h2 for corner 1, h0 for corner 2.
+        const HalfedgeHandle exit = k == 0 ? h1 : k == 1 ? h2 : h0;
+        const FaceHandle g = mesh_.face_handle(mesh_.opposite_halfedge_handle(exit));
+        if (!g.is_valid()) break;
+        f = g;
+      }
+      moved[i] = walk_to_closest(mesh_, q, f, 8);
     });
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!track_[i].face.is_valid()) continue;
+      if (moved[i].face != track_[i].face) {
+        unlink_point(static_cast<int>(i));
+        link_point(static_cast<int>(i), moved[i].face);
+      }
+      track_[i].bary = moved[i].bary;
+    }
+  }
+
+  // The tracked locations made exact: each input vertex's closest point on the output, by a
+  // local walk from its tracked face. The report gets how far the walk had to go.
+  std::vector<SurfacePoint> closest_input_locations(RemeshReport& report) const {
+    const std::size_t n = track_.size();
+    std::vector<SurfacePoint> out(n);
+    std::vector<double> excess(n, 0.0);
+    parallel_for(n, options_.threads, [&](std::size_t i) {
+      if (!track_[i].face.is_valid()) return;
+      const Vec3 q = input_.point(VertexHandle(static_cast<int>(i)));
+      out[i] = walk_to_closest(mesh_, q, track_[i].face, 256);
+      excess[i] = (q - evaluate(mesh_, track_[i])).norm() - (q - evaluate(mesh_, out[i])).norm();
+    });
+    std::size_t located = 0, same = 0;
+    double sum = 0, worst = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!track_[i].face.is_valid()) continue;
+      ++located;
+      same += out[i].face == track_[i].face ? 1 : 0;
+      sum += excess[i];
+      worst = std::max(worst, excess[i]);
+    }
+    const double count = static_cast<double>(std::max<std::size_t>(located, 1));
+    report.tracked_same_face = located > 0 ? static_cast<double>(same) / count : 1.0;
+    report.tracked_excess_mean = sum / count / length_;
+    report.tracked_excess_max = worst / length_;
     return out;
   }
 
@@ -663,8 +806,12 @@ private:
         !(collapse_is_safe(h, target, 1.4 * hi2_) && collapse_raises_min_angle(h, target)))
       return false;
     live_faces_ -= mesh_.is_boundary(e) ? 1 : 2;
+    // The two faces of the edge go: their input vertices move to the survivor's faces.
+    for (auto side : {h, mesh_.opposite_halfedge_handle(h)})
+      if (!mesh_.is_boundary(side)) take_points(mesh_.face_handle(side), displaced_);
     mesh_.collapse(h);
     if (midpoint) mesh_.set_point(b, relocate(b, target, b));
+    place_points_around(b, displaced_);
     return true;
   }
 
@@ -724,6 +871,7 @@ private:
       if (try_collapse(mesh_.edge_handle(hs[shortest]), Collapse::Repair)) ++count;
     }
     mesh_.garbage_collection();
+    rebind_points();
     live_faces_ = mesh_.n_faces();
     return count;
   }
@@ -816,6 +964,7 @@ private:
       const VertexHandle v(static_cast<int>(i));
       mesh_.set_point(v, relocate(v, goal[i], v));
     });
+    reproject_points();
   }
 
   // Where a boundary vertex goes: the midpoint of its two boundary neighbours, relaxed by
@@ -1016,6 +1165,17 @@ private:
   OpenMesh::VPropHandleT<SurfacePoint> loc_prop_;    // where the vertex lies on the input
   OpenMesh::VPropHandleT<HalfedgeHandle> bloc_prop_; // boundary vertices: input boundary halfedge
   OpenMesh::VPropHandleT<Kind> kind_prop_;
+  // Input -> output (see take_points): per input vertex its location and list neighbours.
+  OpenMesh::FPropHandleT<PointList> points_prop_;
+  std::vector<SurfacePoint> track_;
+  std::vector<int> next_, prev_;
+  std::vector<int> displaced_; // scratch: input vertices taken off faces an operation changes
+  void add_working_properties() {
+    mesh_.add_property(loc_prop_);
+    mesh_.add_property(bloc_prop_);
+    mesh_.add_property(kind_prop_);
+    mesh_.add_property(points_prop_);
+  }
   SurfacePoint& loc(VertexHandle v) { return mesh_.property(loc_prop_, v); }
   HalfedgeHandle& bloc(VertexHandle v) { return mesh_.property(bloc_prop_, v); }
   Kind& kind(VertexHandle v) { return mesh_.property(kind_prop_, v); }
@@ -1056,6 +1216,10 @@ nlohmann::json to_json(const RemeshReport& r) {
             {"vertex_max", r.vertex_distance_max},
             {"centroid_mean", r.centroid_distance_mean},
             {"centroid_max", r.centroid_distance_max}}},
+          {"correspondence",
+           {{"tracked_excess_mean", r.tracked_excess_mean},
+            {"tracked_excess_max", r.tracked_excess_max},
+            {"tracked_same_face", r.tracked_same_face}}},
           {"splits", r.splits},
           {"collapses", r.collapses},
           {"flips", r.flips},

@@ -77,6 +77,12 @@ struct RemeshReport {
   /// output vertices (0 when projecting) and of the output faces' centroids (the chord error).
   double vertex_distance_mean = 0.0, vertex_distance_max = 0.0;
   double centroid_distance_mean = 0.0, centroid_distance_max = 0.0;
+  /// The input -> output locations are tracked through every operation and made exact (each
+  /// input vertex's closest point on the output) by a short final walk from the tracked face.
+  /// How much farther from its input vertex a tracked location was than the final one (mean and
+  /// largest, relative to the target length), and the share of tracked faces the walk kept.
+  double tracked_excess_mean = 0.0, tracked_excess_max = 0.0;
+  double tracked_same_face = 0.0;
   std::size_t splits = 0, collapses = 0, flips = 0;
   std::size_t repairs = 0; ///< flips and collapses of triangles below repair_angle_deg
   /// Wall time per phase in milliseconds ("split", "collapse", "flip", "smooth", "repair",
@@ -88,7 +94,8 @@ struct RemeshResult {
   Mesh mesh;
   /// For every output vertex (by index): where it lies on the input.
   std::vector<SurfacePoint> output_on_input;
-  /// For every input vertex (by index): where it lies on the output (its closest point there).
+  /// For every input vertex (by index): where it lies on the output (its closest point there;
+  /// invalid face for an isolated input vertex).
   std::vector<SurfacePoint> input_on_output;
   RemeshReport report;
 };
