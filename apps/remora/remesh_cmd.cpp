@@ -81,36 +81,40 @@ void add_remesh_command(CLI::App& app) {
       app.add_subcommand("remesh", "Isotropic, area-equalizing remesh (paper section 4) of a mesh");
   struct Args {
     std::string in, out;
-    double length = 0, factor = 0.9, lambda = 0.5, smoothing = 1.5;
-    double low_pass = 0; ///< σ of the base-surface filter, in mean edge lengths; 0 = off
+    RemeshOptions options; ///< the library's defaults until a flag says otherwise
+    double low_pass = 0;   ///< σ of the base-surface filter, in mean edge lengths; 0 = off
     std::string method = "newton";
-    int cycles = 5, equalize = 10, threads = 0;
     bool no_project = false, report = false, json = false;
   };
   auto a = std::make_shared<Args>();
+  RemeshOptions& o = a->options;
   cmd->add_option("input", a->in, "Input mesh (.obj .off .ply .stl)")->required();
   cmd->add_option("-o,--output", a->out, "Output mesh; the format follows the extension")
       ->required();
-  auto* length = cmd->add_option("--length", a->length, "Target edge length l (absolute)")
+  auto* length = cmd->add_option("--length", o.target_length, "Target edge length l (absolute)")
                      ->check(CLI::PositiveNumber);
-  cmd->add_option(
-         "--length-factor", a->factor,
-         "l = factor x the input's mean edge length, area-based on needle meshes (default 0.9)")
+  cmd->add_option("--length-factor", o.length_factor,
+                  "l = factor x the input's mean edge length, area-based on needle meshes")
       ->check(CLI::PositiveNumber)
-      ->excludes(length);
-  cmd->add_option("--cycles", a->cycles, "Split/collapse/flip/smooth cycles (default 5)")
-      ->check(CLI::NonNegativeNumber);
-  cmd->add_option("--equalize", a->equalize, "Area-equalizing iterations (default 10)")
-      ->check(CLI::NonNegativeNumber);
-  cmd->add_option("--lambda", a->lambda, "Damping of the area-equalizing update, in (0, 1]")
-      ->check(CLI::Range(0.0, 1.0));
+      ->excludes(length)
+      ->capture_default_str();
+  cmd->add_option("--cycles", o.cycles, "Split/collapse/flip/smooth cycles")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  cmd->add_option("--equalize", o.equalize_iterations, "Area-equalizing iterations")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  cmd->add_option("--lambda", o.lambda, "Damping of the area-equalizing update, in (0, 1]")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
   cmd->add_option("--method", a->method,
                   "Area equalization: newton (default) or gravity (the paper's update)")
       ->check(CLI::IsMember({"newton", "gravity"}));
-  cmd->add_option("--smoothing", a->smoothing,
-                  "newton: weight of the shape-keeping smoothing term (default 1.5)")
-      ->check(CLI::NonNegativeNumber);
-  cmd->add_option("--threads", a->threads, "Worker threads (default: all)")
+  cmd->add_option("--smoothing", o.equalize_smoothing,
+                  "newton: weight of the shape-keeping smoothing term")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  cmd->add_option("--threads", o.threads, "Worker threads (default: all)")
       ->check(CLI::NonNegativeNumber);
   cmd->add_flag("--no-project", a->no_project,
                 "Keep vertex updates in the tangent plane instead of projecting onto the input");
@@ -128,15 +132,8 @@ void add_remesh_command(CLI::App& app) {
       LowPassFilter filter(loaded.mesh, {.smoothing = a->low_pass});
       set_positions(loaded.mesh, filter.apply(positions_matrix(loaded.mesh)));
     }
-    RemeshOptions options;
-    options.target_length = a->length;
-    options.length_factor = a->factor;
-    options.cycles = a->cycles;
-    options.equalize_iterations = a->equalize;
-    options.lambda = a->lambda;
+    RemeshOptions options = a->options;
     options.equalization = a->method == "gravity" ? Equalization::Gravity : Equalization::Newton;
-    options.equalize_smoothing = a->smoothing;
-    options.threads = a->threads;
     options.project = !a->no_project;
     options.compute_report = a->report || a->json; // the figures cost 10-16 % of the time
     ProgressLine progress;
