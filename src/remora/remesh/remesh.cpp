@@ -715,15 +715,22 @@ private:
     return !(n_tips == 2 && k == 3 && valence_b == 3);
   }
 
-  // Would moving `keep` to `p` (after removing `gone`) flip or collapse a face, or create an
-  // edge longer than √max_length2 (4/3 l in the cycles)?
-  bool collapse_is_safe(HalfedgeHandle h, const Vec3& p, double max_length2) {
+  // Would merging a and b at p leave every edge of the survivor within √max_length2 (4/3 l in
+  // the cycles)?
+  bool neighbours_within(VertexHandle a, VertexHandle b, const Vec3& p, double max_length2) const {
+    for (VertexHandle v : {a, b})
+      for (auto w : mesh_.vv_range(v))
+        if (w != a && w != b && (mesh_.point(w) - p).sqrnorm() > max_length2) return false;
+    return true;
+  }
+
+  // Would moving `keep` to `p` (after removing `gone`) keep every remaining face's orientation
+  // (within 60 degrees) and a non-trivial area?
+  bool collapse_keeps_orientation(HalfedgeHandle h, const Vec3& p) const {
     const VertexHandle gone = mesh_.from_vertex_handle(h), keep = mesh_.to_vertex_handle(h);
     const FaceHandle fl = mesh_.face_handle(h),
                      fr = mesh_.face_handle(mesh_.opposite_halfedge_handle(h));
     for (VertexHandle v : {gone, keep}) {
-      for (auto w : mesh_.vv_range(v))
-        if (w != gone && w != keep && (mesh_.point(w) - p).sqrnorm() > max_length2) return false;
       for (auto f : mesh_.vf_range(v)) {
         if (f == fl || f == fr) continue;
         auto fv = face_vertices(mesh_, f);
@@ -783,7 +790,8 @@ private:
 
   // Collapses e if the rules allow it: corners never go, an interior vertex goes onto a boundary
   // vertex (which stays put), two boundary vertices merge along a boundary edge only, and the
-  // result passes collapse_is_safe(). Otherwise the survivor moves to the midpoint.
+  // survivor's edges stay short, the mesh stays manifold and no face turns over. Otherwise the
+  // survivor moves to the midpoint.
   bool try_collapse(EdgeHandle e, Collapse purpose = Collapse::Short) {
     HalfedgeHandle h = mesh_.halfedge_handle(e, 0);
     VertexHandle a = mesh_.from_vertex_handle(h), b = mesh_.to_vertex_handle(h);
@@ -799,19 +807,21 @@ private:
     } else if (kb == Kind::Corner || (kb == Kind::Boundary && ka == Kind::Interior)) {
       midpoint = false; // remove a, keep b where it is
     }
+    const Vec3 target = midpoint ? (mesh_.point(a) + mesh_.point(b)) * 0.5 : mesh_.point(b);
+    // A repair may leave an edge up to √1.4 × 4/3 l ≈ 1.58 l long (one long edge costs the
+    // Laplacian less than a sliver), and must raise the smallest angle around it. The length
+    // test comes first: it is the cheapest and the one that fails most (two thirds of the short
+    // edges of a cycle cannot go without leaving an edge longer than 4/3 l).
+    if (!neighbours_within(a, b, target, purpose == Collapse::Short ? hi2_ : 1.4 * hi2_))
+      return false;
     if (!collapse_keeps_manifold(h)) {
       if (!midpoint) return false;
       h = mesh_.opposite_halfedge_handle(h);
       std::swap(a, b);
       if (!collapse_keeps_manifold(h)) return false;
     }
-    const Vec3 target = midpoint ? (mesh_.point(a) + mesh_.point(b)) * 0.5 : mesh_.point(b);
-    if (purpose == Collapse::Short && !collapse_is_safe(h, target, hi2_)) return false;
-    // A repair may leave an edge up to √1.4 × 4/3 l ≈ 1.58 l long (one long edge costs the
-    // Laplacian less than a sliver), and must raise the smallest angle around it.
-    if (purpose == Collapse::Repair &&
-        !(collapse_is_safe(h, target, 1.4 * hi2_) && collapse_raises_min_angle(h, target)))
-      return false;
+    if (!collapse_keeps_orientation(h, target)) return false;
+    if (purpose == Collapse::Repair && !collapse_raises_min_angle(h, target)) return false;
     live_faces_ -= mesh_.is_boundary(e) ? 1 : 2;
     // The two faces of the edge go: their input vertices move to the survivor's faces.
     for (auto side : {h, mesh_.opposite_halfedge_handle(h)})
