@@ -641,15 +641,23 @@ private:
 
   // --- the four steps of a cycle -------------------------------------------------------------
 
+  // Splits every edge longer than 4/3 l at its midpoint, in passes until none is left. The
+  // splits of a pass are sequential; the new vertices are placed on the input afterwards, all at
+  // once and data-parallel: a pass only visits edges that existed when it began, so no split
+  // needs a vertex the same pass made, and each new vertex walks from the location of an old one.
   std::size_t split_long_edges() {
     std::size_t count = 0;
+    struct NewVertex {
+      VertexHandle v, near;
+      Vec3 at;
+    };
+    std::vector<NewVertex> made;
     for (int pass = 0; pass < 10; ++pass) {
-      std::size_t split_now = 0;
+      made.clear();
       const std::size_t n = mesh_.n_edges();
-      for (std::size_t i = 0; i < n; ++i) {
+      for (std::size_t i = 0; i < n && live_faces_ < max_faces_; ++i) {
         const EdgeHandle e(static_cast<int>(i));
         if (mesh_.status(e).deleted()) continue;
-        if (live_faces_ >= max_faces_) return count + split_now;
         const HalfedgeHandle h = mesh_.halfedge_handle(e, 0);
         const VertexHandle a = mesh_.from_vertex_handle(h), b = mesh_.to_vertex_handle(h);
         const Vec3 pa = mesh_.point(a), pb = mesh_.point(b);
@@ -659,17 +667,15 @@ private:
         const VertexHandle v = mesh_.split(e, mid);
         live_faces_ += on_boundary ? 1 : 2;
         kind(v) = on_boundary ? Kind::Boundary : Kind::Interior;
-        if (on_boundary) {
-          // Walk the input boundary from an endpoint that lies on it.
-          const VertexHandle from = kind(a) != Kind::Interior ? a : b;
-          mesh_.set_point(v, relocate(v, mid, from));
-        } else {
-          mesh_.set_point(v, relocate(v, mid, a));
-        }
-        ++split_now;
+        // On the boundary, walk the input boundary from an endpoint that lies on it.
+        made.push_back({v, on_boundary && kind(a) == Kind::Interior ? b : a, mid});
       }
-      count += split_now;
-      if (split_now == 0) break;
+      parallel_for(made.size(), options_.threads, [&](std::size_t k) {
+        const NewVertex& m = made[k];
+        mesh_.set_point(m.v, relocate(m.v, m.at, m.near));
+      });
+      count += made.size();
+      if (made.empty() || live_faces_ >= max_faces_) break;
     }
     return count;
   }
