@@ -342,9 +342,11 @@ void expect_papers_area_figures(const RemeshResult& r, SymmetryRows rows) {
                                       : rep.symmetry_defect_output_interior,
             0.06);
   EXPECT_GT(fraction_in_band(r.mesh, rep.target_length), 0.95);
-  // The tracked input -> output locations are (all but) the closest points already.
+  // The tracked input -> output locations are (all but) the closest points already. The largest
+  // gap is one vertex's: on camelhead's flap (two sheets about 0.36 l apart) the closest point
+  // of a few input vertices lies on the other sheet.
   EXPECT_LT(rep.tracked_excess_mean, 1e-3);
-  EXPECT_LT(rep.tracked_excess_max, 0.25);
+  EXPECT_LT(rep.tracked_excess_max, 0.5);
 }
 
 // The paper's claims on real closed meshes of ../shared/data (skipped when absent).

@@ -780,15 +780,26 @@ private:
     return after > before;
   }
 
+  // Collapses every edge shorter than 4/5 l that the rules allow (try_collapse), sequentially;
+  // the survivors that moved to a midpoint are placed on the input afterwards, together and
+  // data-parallel (each from its own location, as a placement right after its collapse would).
   std::size_t collapse_short_edges() {
     std::size_t count = 0;
+    std::vector<VertexHandle> survivors;
     const std::size_t n = mesh_.n_edges();
     for (std::size_t i = 0; i < n; ++i) {
       const EdgeHandle e(static_cast<int>(i));
       if (mesh_.status(e).deleted()) continue;
       if (mesh_.calc_edge_sqr_length(e) >= lo2_) continue;
-      count += try_collapse(e) ? 1 : 0;
+      count += try_collapse(e, Collapse::Short, &survivors) ? 1 : 0;
     }
+    // A survivor may have merged again (and moved on, or gone): each live one once.
+    std::sort(survivors.begin(), survivors.end());
+    survivors.erase(std::unique(survivors.begin(), survivors.end()), survivors.end());
+    parallel_for(survivors.size(), options_.threads, [&](std::size_t k) {
+      const VertexHandle v = survivors[k];
+      if (!mesh_.status(v).deleted()) mesh_.set_point(v, relocate(v, mesh_.point(v), v));
+    });
     return count;
   }
 
@@ -797,8 +808,9 @@ private:
   // Collapses e if the rules allow it: corners never go, an interior vertex goes onto a boundary
   // vertex (which stays put), two boundary vertices merge along a boundary edge only, and the
   // survivor's edges stay short, the mesh stays manifold and no face turns over. Otherwise the
-  // survivor moves to the midpoint.
-  bool try_collapse(EdgeHandle e, Collapse purpose = Collapse::Short) {
+  // survivor moves to the midpoint, and onto the input at once, or when `defer` is given, later
+  // by the caller (it gets the survivor).
+  bool try_collapse(EdgeHandle e, Collapse purpose, std::vector<VertexHandle>* defer = nullptr) {
     HalfedgeHandle h = mesh_.halfedge_handle(e, 0);
     VertexHandle a = mesh_.from_vertex_handle(h), b = mesh_.to_vertex_handle(h);
     const Kind ka = kind(a), kb = kind(b);
@@ -833,7 +845,12 @@ private:
     for (auto side : {h, mesh_.opposite_halfedge_handle(h)})
       if (!mesh_.is_boundary(side)) take_points(mesh_.face_handle(side), displaced_);
     mesh_.collapse(h);
-    if (midpoint) mesh_.set_point(b, relocate(b, target, b));
+    if (midpoint && defer) {
+      mesh_.set_point(b, target);
+      defer->push_back(b);
+    } else if (midpoint) {
+      mesh_.set_point(b, relocate(b, target, b));
+    }
     place_points_around(b, displaced_);
     return true;
   }
