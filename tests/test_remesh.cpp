@@ -434,6 +434,20 @@ TEST_P(RemeshUglyData, RepairsNeverLowerTheSmallestAngle) {
   EXPECT_GE(repaired.report.after_cycles.angles.min_deg, before);
 }
 
+// The sharp creases of gears.stl can put three output vertices on one line. At 0.6 of the
+// default length that left four flat faces, whose shortest edge could not go: the repair then
+// tries the face's other edges too.
+TEST(RemeshGears, NoFlatFacesAtAnotherLength) {
+  const std::string path = shared_mesh("cad/gears.stl");
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " not present";
+  const Mesh input = read_mesh(path).mesh;
+  RemeshOptions options;
+  options.length_factor = 0.6;
+  options.compute_report = false;
+  const RemeshResult r = remesh(input, options);
+  expect_sound_output(r, input);
+}
+
 INSTANTIATE_TEST_SUITE_P(CiMeshes, RemeshUglyData,
                          ::testing::Values("cad/conrod.stl", "cad/featuretype.STL", "cad/gears.stl",
                                            "open/camelhead.off", "heightfield/AcrossRiver.stl"),

@@ -921,9 +921,27 @@ private:
           continue;
         }
       }
-      if (try_collapse(mesh_.edge_handle(hs[shortest]), Collapse::Repair)) ++count;
+      if (try_collapse(mesh_.edge_handle(hs[shortest]), Collapse::Repair)) {
+        ++count;
+        continue;
+      }
+      // A flat face (three corners on a line, as on a sharp crease) is worth any collapse of
+      // its edges that the rules allow, the other two included.
+      if (face_cross(f).norm() > 1e-6 * length_ * length_) continue;
+      for (int k : {(shortest + 1) % 3, (shortest + 2) % 3})
+        if (try_collapse(mesh_.edge_handle(hs[k]), Collapse::Repair)) {
+          ++count;
+          break;
+        }
     }
     return count;
+  }
+
+  // Twice the area vector of face f at the current positions.
+  Vec3 face_cross(FaceHandle f) const {
+    const auto fv = face_vertices(mesh_, f);
+    const Vec3& p = mesh_.point(fv[0]);
+    return OpenMesh::cross(mesh_.point(fv[1]) - p, mesh_.point(fv[2]) - p);
   }
 
   // One pass of valence-improving flips over all edges. Valences and targets (6 inside, 4 on
