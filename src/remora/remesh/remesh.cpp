@@ -574,7 +574,8 @@ private:
   // over. Data-parallel, then the lists are updated in input order.
   void reproject_points() {
     const std::size_t n = track_.size();
-    std::vector<SurfacePoint> moved(n);
+    std::vector<SurfacePoint>& moved = reprojected_; // kept between calls: no fresh pages each time
+    moved.resize(n);
     parallel_for(n, options_.threads, [&](std::size_t i) {
       if (!track_[i].face.is_valid()) return;
       const Vec3 q = input_.point(VertexHandle(static_cast<int>(i)));
@@ -1242,6 +1243,7 @@ private:
   std::vector<SurfacePoint> track_;
   std::vector<int> next_, prev_;
   std::vector<int> displaced_; // scratch: input vertices taken off faces an operation changes
+  std::vector<SurfacePoint> reprojected_; // scratch of reproject_points()
   void add_working_properties() {
     mesh_.add_property(loc_prop_);
     mesh_.add_property(bloc_prop_);
