@@ -1015,26 +1015,26 @@ private:
   }
 
   // Moves every vertex by `update(v)` (tangential for interior vertices, along the boundary for
-  // boundary ones), then back onto the input. Two data-parallel phases: all targets are
-  // computed from the current positions, then all vertices move.
+  // boundary ones), then back onto the input. One data-parallel loop computes each target from
+  // the current positions and places it on the input (a relocation reads and writes only its
+  // own vertex's location); the new positions are applied after it.
   template <class Target>
   void move_vertices(Target&& target) {
     const std::size_t n = mesh_.n_vertices();
-    std::vector<Vec3> goal(n);
-    std::vector<char> moves(n, 0);
+    std::vector<Vec3>& placed = placed_; // kept between calls: no fresh pages each time
+    std::vector<char>& moves = moves_;
+    placed.resize(n);
+    moves.assign(n, 0);
     parallel_for(n, options_.threads, [&](std::size_t i) {
       const VertexHandle v(static_cast<int>(i));
       if (mesh_.status(v).deleted() || kind(v) == Kind::Corner || mesh_.is_isolated(v)) return;
       Vec3 g;
       if (!target(v, g)) return;
-      goal[i] = g;
+      placed[i] = relocate(v, g, v);
       moves[i] = 1;
     });
-    parallel_for(n, options_.threads, [&](std::size_t i) {
-      if (!moves[i]) return;
-      const VertexHandle v(static_cast<int>(i));
-      mesh_.set_point(v, relocate(v, goal[i], v));
-    });
+    for (std::size_t i = 0; i < n; ++i)
+      if (moves[i]) mesh_.set_point(VertexHandle(static_cast<int>(i)), placed[i]);
     reproject_points();
   }
 
@@ -1242,6 +1242,8 @@ private:
   std::vector<int> next_, prev_;
   std::vector<int> displaced_; // scratch: input vertices taken off faces an operation changes
   std::vector<SurfacePoint> reprojected_; // scratch of reproject_points()
+  std::vector<Vec3> placed_;              // scratch of move_vertices()
+  std::vector<char> moves_;               // scratch of move_vertices()
   void add_working_properties() {
     mesh_.add_property(loc_prop_);
     mesh_.add_property(bloc_prop_);
