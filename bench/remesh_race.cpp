@@ -39,6 +39,7 @@
 #include <fmt/core.h>
 #include <nlohmann/json.hpp>
 
+#include "remora/common/memory.h"
 #include "remora/geometry/measures.h"
 #include "remora/geometry/quality.h"
 #include "remora/mesh/io.h"
@@ -59,6 +60,7 @@ struct Args {
   bool json = false;
   int threads = 0;
   bool cgal_relax_boundary = false;
+  bool fresh_memory = false;
   std::string write_dir;
   std::vector<std::string> files;
 };
@@ -491,12 +493,17 @@ int main(int argc, char** argv) {
   app.add_flag("--cgal-relax-boundary", args.cgal_relax_boundary,
                "CGAL relax_constraints(true): boundary vertices slide along boundary chords");
   app.add_option("--write-dir", args.write_dir, "Write both outputs of every mesh as PLY here");
+  app.add_flag("--fresh-memory", args.fresh_memory,
+               "Leave glibc's defaults (the remora CLI keeps freed memory for reuse, so does this "
+               "benchmark unless told so; it applies to both contenders)");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? 0 : 2;
   }
 
+  // Both contenders run in this process under the same allocator settings, those of the CLI.
+  const bool kept = !args.fresh_memory && remora::keep_freed_memory();
   const std::string shared = REMORA_SHARED_DATA;
   std::vector<std::string> paths = args.files;
   if (paths.empty())
@@ -509,14 +516,15 @@ int main(int argc, char** argv) {
   const double load_before = load_average();
   if (!args.json)
     fmt::print("# remora::remesh vs CGAL {} isotropic_remeshing\n\nmachine: {}, {} hardware "
-               "threads; ours: {}; CGAL: 1 thread, boundary {}; 1-min load average at "
-               "start {}\n\n",
+               "threads; ours: {}; CGAL: 1 thread, boundary {}; freed memory {}; 1-min load "
+               "average at start {}\n\n",
                CGAL_VERSION_STR, cpu_model(), std::thread::hardware_concurrency(),
                args.threads == 1  ? std::string("1 thread")
                : args.threads > 1 ? fmt::format("{} threads", args.threads)
                                   : std::string("all threads"),
                args.cgal_relax_boundary ? "relaxed along chords (relax_constraints)"
                                         : "kept (CGAL default)",
+               kept ? "kept for reuse (as the CLI)" : "returned (glibc defaults)",
                fixed_or_na(load_before, 2));
   std::fflush(stdout);
 
@@ -554,6 +562,7 @@ int main(int argc, char** argv) {
                         {"length_factor", kLengthFactor},
                         {"repeat", args.repeat},
                         {"cgal_relax_boundary", args.cgal_relax_boundary},
+                        {"freed_memory_kept", kept},
                         {"meshes", nlohmann::json::array()}};
     for (const MeshRace& r : races) j["meshes"].push_back(to_json(r));
     std::cout << j.dump(2) << "\n";

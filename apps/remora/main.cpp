@@ -10,8 +10,10 @@
 
 #include "commands.h"
 #include "remora/common/error.h"
+#include "remora/common/memory.h"
 
 int main(int argc, char** argv) {
+  remora::keep_freed_memory(); // a one-shot process: page faults cost more than a kept heap
   CLI::App app{"Remora: detail-preserving multiresolution editing of triangle meshes"};
   app.require_subcommand(1);
   app.set_version_flag("--version", std::string("remora ") + REMORA_VERSION);

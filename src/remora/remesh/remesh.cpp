@@ -1109,7 +1109,8 @@ private:
     // The mixed-area parts of every face at the current positions (face_vertices order), and the
     // vertex areas they sum to.
     const std::size_t nf = mesh_.n_faces();
-    std::vector<std::array<double, 3>> face_parts(nf);
+    std::vector<std::array<double, 3>>& face_parts = face_parts_; // kept between iterations
+    face_parts.resize(nf);
     parallel_for(nf, options_.threads, [&](std::size_t i) {
       const FaceHandle f(static_cast<int>(i));
       if (mesh_.status(f).deleted()) return;
@@ -1117,7 +1118,8 @@ private:
       face_parts[i] =
           triangle_mixed_areas(mesh_.point(fv[0]), mesh_.point(fv[1]), mesh_.point(fv[2]));
     });
-    std::vector<double> area(mesh_.n_vertices(), 0.0);
+    std::vector<double>& area = vertex_areas_;
+    area.assign(mesh_.n_vertices(), 0.0);
     for (std::size_t i = 0; i < nf; ++i) {
       const FaceHandle f(static_cast<int>(i));
       if (mesh_.status(f).deleted()) continue;
@@ -1241,9 +1243,11 @@ private:
   std::vector<SurfacePoint> track_;
   std::vector<int> next_, prev_;
   std::vector<int> displaced_; // scratch: input vertices taken off faces an operation changes
-  std::vector<SurfacePoint> reprojected_; // scratch of reproject_points()
-  std::vector<Vec3> placed_;              // scratch of move_vertices()
-  std::vector<char> moves_;               // scratch of move_vertices()
+  std::vector<SurfacePoint> reprojected_;         // scratch of reproject_points()
+  std::vector<Vec3> placed_;                      // scratch of move_vertices()
+  std::vector<char> moves_;                       // scratch of move_vertices()
+  std::vector<std::array<double, 3>> face_parts_; // scratch of equalize_areas_newton()
+  std::vector<double> vertex_areas_;              // scratch of equalize_areas_newton()
   void add_working_properties() {
     mesh_.add_property(loc_prop_);
     mesh_.add_property(bloc_prop_);

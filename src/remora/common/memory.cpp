@@ -1,0 +1,21 @@
+#include "remora/common/memory.h"
+
+#include <cstdlib> // defines __GLIBC__ under glibc
+
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
+
+namespace remora {
+
+bool keep_freed_memory() {
+#if defined(__GLIBC__)
+  constexpr int kGiB = 1 << 30;
+  // Allocations below 1 GiB come from the heap; the heap's top is returned only above 1 GiB free.
+  return mallopt(M_MMAP_THRESHOLD, kGiB) == 1 && mallopt(M_TRIM_THRESHOLD, kGiB) == 1;
+#else
+  return false;
+#endif
+}
+
+} // namespace remora

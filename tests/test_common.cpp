@@ -1,0 +1,46 @@
+// common/: the data-parallel loop and the allocator settings of the apps.
+#include <atomic>
+#include <cstddef>
+#include <vector>
+
+#if defined(__GLIBC__)
+#include <malloc.h>
+#endif
+
+#include <gtest/gtest.h>
+
+#include "remora/common/memory.h"
+#include "remora/common/parallel.h"
+
+namespace remora {
+namespace {
+
+TEST(ParallelFor, VisitsEveryIndexOnceWhateverTheThreadCount) {
+  for (std::size_t n : {std::size_t{0}, std::size_t{1}, std::size_t{1024}, std::size_t{1025},
+                        std::size_t{100003}}) {
+    for (int threads : {1, 2, 0}) {
+      std::vector<std::atomic<int>> visits(n);
+      parallel_for(n, threads, [&](std::size_t i) { visits[i].fetch_add(1); });
+      for (std::size_t i = 0; i < n; ++i)
+        ASSERT_EQ(visits[i].load(), 1) << "n = " << n << ", threads = " << threads << ", i = " << i;
+    }
+  }
+}
+
+TEST(Memory, KeepFreedMemoryServesLargeBlocksFromTheHeap) {
+#if !defined(__GLIBC__) || defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "glibc's allocator only (the sanitizers bring their own)";
+#else
+  ASSERT_TRUE(keep_freed_memory());
+  // 64 MiB is above glibc's largest automatic mmap threshold (32 MiB): by default such a block
+  // is a fresh mapping, counted in hblkhd, and unmapped on free.
+  const std::size_t mapped_before = mallinfo2().hblkhd;
+  {
+    std::vector<char> big(std::size_t{64} << 20, 1);
+    EXPECT_EQ(mallinfo2().hblkhd, mapped_before) << "the block was mapped, not taken from the heap";
+  }
+#endif
+}
+
+} // namespace
+} // namespace remora
