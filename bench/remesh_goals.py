@@ -48,6 +48,7 @@ def row(name, d):
     mean_dev = eq["angles"]["mean_abs_deviation_from_60_deg"]
     excess = d["correspondence"]["tracked_excess_mean"]
     flat = eq["zero_area_faces"]
+    band = d["edges_in_band_percent"]["output"]
 
     def mark(ok):
         return "" if ok else " ✗"
@@ -57,7 +58,7 @@ def row(name, d):
         defect_cell += f" (inside: {inside:.3f})"
     return (f"| {name} | {mad:.3f}{mark(mad <= 0.05)} | {var:.1f}×{mark(var >= 5)} | {defect_cell} "
             f"| {min_deg:.1f}{mark(min_deg >= 25)} | {mean_dev:.2f}{mark(mean_dev <= 7)} "
-            f"| {excess:.0e} | {flat}{mark(flat == 0)} |")
+            f"| {band:.1f}{mark(band >= 99)} | {excess:.0e} | {flat}{mark(flat == 0)} |")
 
 
 def main():
@@ -81,8 +82,9 @@ def main():
     with concurrent.futures.ThreadPoolExecutor(max_workers=args.jobs) as pool:
         futures = [pool.submit(run, args.remora, p, lp, args.extra) for _, p, lp in jobs]
         print("| mesh | rel MAD ≤ 0.05 | var ↓ ≥ 5× | symmetry defect ≤ 0.06 | min angle ≥ 25° "
-              "| mean \\|θ−60°\\| ≤ 7° | tracked input → output, mean excess / l | flat faces |")
-        print("|---|---|---|---|---|---|---|---|")
+              "| mean \\|θ−60°\\| ≤ 7° | edges in [4/5, 4/3] l ≥ 99 % "
+              "| tracked input → output, mean excess / l | flat faces |")
+        print("|---|---|---|---|---|---|---|---|---|")
         for (name, _, _), fut in zip(jobs, futures):
             try:
                 print(row(name, fut.result()), flush=True)

@@ -181,14 +181,7 @@ OutputFigures output_figures(const remora::Mesh& mesh, double l,
   out.mixed_area_rel_mad = q.mixed_area.rel_mad;
   out.percent_interior_valence_6 = q.valence.percent_interior_6;
   out.mean_edge_over_l = q.edge_length.mean / l;
-  std::size_t edges = 0, in_band = 0;
-  for (auto e : mesh.edges()) {
-    const double len = mesh.calc_edge_length(e);
-    ++edges;
-    if (len >= 0.8 * l && len <= 4.0 / 3.0 * l) ++in_band;
-  }
-  out.percent_edges_in_band =
-      edges ? 100.0 * static_cast<double>(in_band) / static_cast<double>(edges) : 0.0;
+  out.percent_edges_in_band = remora::percent_edges_within(mesh, 0.8 * l, 4.0 / 3.0 * l);
   double deviation = 0;
   for (auto v : mesh.vertices()) {
     if (!mesh.is_boundary(v) || mesh.is_isolated(v)) continue;

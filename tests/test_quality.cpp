@@ -427,6 +427,11 @@ TEST(QualityGrid, RectangularCellsHandComputed) {
   EXPECT_NEAR(q.edge_length.cv, std::sqrt(variance) / mean, 1e-13);
   EXPECT_DOUBLE_EQ(q.edge_length.min, h);
   EXPECT_DOUBLE_EQ(q.edge_length.max, d);
+  const Mesh grid = make_grid(nx, ny, nx * w, ny * h, GridSplit::Uniform);
+  EXPECT_NEAR(percent_edges_within(grid, 0.4, 0.55), 100.0 * nw / n, 1e-12);   // w, not d
+  EXPECT_NEAR(percent_edges_within(grid, h, w), 100.0 * (nw + nh) / n, 1e-12); // ends count
+  EXPECT_NEAR(percent_edges_within(grid, 0.0, 10.0), 100.0, 1e-12);
+  EXPECT_EQ(percent_edges_within(grid, 0.6, 0.0), 0.0); // empty band
 
   // Every interior vertex owns one cell w h, by both rules.
   EXPECT_EQ(q.interior_vertices, static_cast<std::size_t>((nx - 1) * (ny - 1)));

@@ -54,6 +54,8 @@ void print_remesh_report(std::ostream& os, const RemeshReport& r) {
   line(
       "mixed area rel std", [](const MeshQuality& q) { return q.mixed_area.rel_std; },
       "{:>12.4f}{:>14.4f}{:>14.4f}");
+  os << fmt::format("{:<28}{:>12}{:>14.1f}{:>14.1f}\n", "% edges in [4/5 l, 4/3 l]", "",
+                    r.edges_in_band_cycles, r.edges_in_band_output);
   os << fmt::format("{:<28}{:>12.4f}{:>14.4f}{:>14.4f}\n", "Laplacian symmetry defect",
                     r.symmetry_defect_input, r.symmetry_defect_cycles, r.symmetry_defect_output);
   if (r.symmetry_defect_output_interior != r.symmetry_defect_output)

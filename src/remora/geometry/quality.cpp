@@ -136,6 +136,16 @@ nlohmann::json point_json(const Vec3& p) {
 
 } // namespace
 
+double percent_edges_within(const Mesh& mesh, double lo, double hi) {
+  std::size_t edges = 0, within = 0;
+  for (const EdgeHandle e : mesh.edges()) {
+    const double length = mesh.calc_edge_length(e);
+    ++edges;
+    if (length >= lo && length <= hi) ++within;
+  }
+  return edges > 0 ? 100.0 * static_cast<double>(within) / static_cast<double>(edges) : 0.0;
+}
+
 MeshQuality mesh_quality(const Mesh& mesh) {
   MeshQuality q;
 

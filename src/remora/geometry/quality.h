@@ -81,6 +81,10 @@ struct MeshQuality {
 
 MeshQuality mesh_quality(const Mesh& mesh);
 
+/// Percentage of the (live) edges whose length lies in [lo, hi]: the remesher's band is
+/// [4/5 l, 4/3 l] (§4). 0 for a mesh without edges.
+double percent_edges_within(const Mesh& mesh, double lo, double hi);
+
 /// Stable snake_case keys mirroring the struct; valence histograms are arrays of
 /// {"valence": v, "count": n} in increasing valence, bounding-box corners are [x, y, z].
 nlohmann::json to_json(const MeshQuality& quality);

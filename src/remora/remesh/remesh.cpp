@@ -108,6 +108,7 @@ public:
         Mesh compacted = mesh_;
         compacted.garbage_collection();
         report.after_cycles = mesh_quality(compacted);
+        report.edges_in_band_cycles = percent_edges_within(compacted, 0.8 * length_, hi_);
         report.symmetry_defect_cycles = laplacian_symmetry_defect(compacted);
       });
 
@@ -123,6 +124,7 @@ public:
     if (figures)
       timed("report", [&] {
         report.after_equalization = mesh_quality(mesh_);
+        report.edges_in_band_output = percent_edges_within(mesh_, 0.8 * length_, hi_);
         report.symmetry_defect_output = laplacian_symmetry_defect(mesh_);
         report.symmetry_defect_output_interior =
             laplacian_symmetry_defect(mesh_, SymmetryRows::Interior);
@@ -1284,6 +1286,8 @@ nlohmann::json to_json(const RemeshReport& r) {
           {"input", to_json(r.input)},
           {"after_cycles", to_json(r.after_cycles)},
           {"after_equalization", to_json(r.after_equalization)},
+          {"edges_in_band_percent",
+           {{"after_cycles", r.edges_in_band_cycles}, {"output", r.edges_in_band_output}}},
           {"symmetry_defect",
            {{"input", r.symmetry_defect_input},
             {"after_cycles", r.symmetry_defect_cycles},

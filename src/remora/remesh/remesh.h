@@ -68,6 +68,8 @@ struct RemeshReport {
   MeshQuality input;
   MeshQuality after_cycles;
   MeshQuality after_equalization;
+  /// Percentage of edges within [4/5 l, 4/3 l], after the cycles and after the fine-tuning.
+  double edges_in_band_cycles = 0.0, edges_in_band_output = 0.0;
   double symmetry_defect_input = 0.0; ///< laplacian_symmetry_defect() of the input
   double symmetry_defect_cycles = 0.0;
   double symmetry_defect_output = 0.0;
