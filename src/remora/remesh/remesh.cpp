@@ -1076,6 +1076,53 @@ private:
       equalize_areas_gravity();
     else
       equalize_areas_newton();
+    if (options_.equalize_flips) delaunay_flips();
+  }
+
+  // Flips every interior edge whose opposite angles sum to more than π (cot α + cot β < 0),
+  // where the flip keeps the mesh manifold and the faces' orientation. The test runs on all
+  // edges at once, data-parallel; the flips of the marked edges follow in edge order, each
+  // tested again on the mesh as the earlier flips left it.
+  std::size_t delaunay_flips() {
+    const std::size_t n = mesh_.n_edges();
+    std::vector<char>& marked = moves_; // scratch (move_vertices is done with it)
+    marked.assign(n, 0);
+    parallel_for(n, options_.threads, [&](std::size_t i) {
+      const EdgeHandle e(static_cast<int>(i));
+      if (mesh_.status(e).deleted() || mesh_.is_boundary(e)) return;
+      marked[i] = violates_delaunay(e) ? 1 : 0;
+    });
+    std::size_t count = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      if (!marked[i]) continue;
+      const EdgeHandle e(static_cast<int>(i));
+      if (!violates_delaunay(e) || !mesh_.is_flip_ok(e)) continue;
+      const HalfedgeHandle h0 = mesh_.halfedge_handle(e, 0), h1 = mesh_.halfedge_handle(e, 1);
+      const VertexHandle a = mesh_.to_vertex_handle(h0), b = mesh_.to_vertex_handle(h1);
+      const VertexHandle c = mesh_.to_vertex_handle(mesh_.next_halfedge_handle(h0));
+      const VertexHandle d = mesh_.to_vertex_handle(mesh_.next_halfedge_handle(h1));
+      if (!flip_keeps_orientation(a, b, c, d)) continue;
+      mesh_.flip(e);
+      ++count;
+    }
+    return count;
+  }
+
+  // Do the two angles opposite interior edge e sum to more than π?
+  bool violates_delaunay(EdgeHandle e) const {
+    const HalfedgeHandle h0 = mesh_.halfedge_handle(e, 0), h1 = mesh_.halfedge_handle(e, 1);
+    const Vec3& a = mesh_.point(mesh_.to_vertex_handle(h0));
+    const Vec3& b = mesh_.point(mesh_.to_vertex_handle(h1));
+    const Vec3& c = mesh_.point(mesh_.to_vertex_handle(mesh_.next_halfedge_handle(h0)));
+    const Vec3& d = mesh_.point(mesh_.to_vertex_handle(mesh_.next_halfedge_handle(h1)));
+    // cot of the angle at c (between c->a and c->b) and at d; their sum is negative exactly when
+    // the angles sum to more than π.
+    const Vec3 ca = a - c, cb = b - c, da = a - d, db = b - d;
+    const double dc = OpenMesh::dot(ca, cb), dd = OpenMesh::dot(da, db);
+    if (dc >= 0 && dd >= 0) return false; // two angles of at most 90 degrees: most edges
+    const double sc = OpenMesh::cross(ca, cb).norm(), sd = OpenMesh::cross(da, db).norm();
+    if (!(sc > 0) || !(sd > 0)) return false; // degenerate: the repair's business
+    return dc * sd + dd * sc < 0;
   }
 
   // §4: p_i += λ (I − n nᵀ)(g_i − p_i), g_i the area-weighted centroid of the one-ring.

@@ -45,6 +45,9 @@ struct RemeshOptions {
   double lambda = 0.75;
   /// Newton only: weight μ of the tangential-smoothing term, relative to the area term.
   double equalize_smoothing = 1.5;
+  /// After every fine-tuning iteration, flip the edges whose opposite angles sum to more than π
+  /// (intrinsic Delaunay flips): the fine-tuning then costs less triangle shape (docs/remesh.md).
+  bool equalize_flips = true;
   /// Project moved vertices back onto the input surface (true), or only keep updates in the
   /// tangent plane (the paper's cheaper variant).
   bool project = true;
