@@ -116,6 +116,8 @@ void add_remesh_command(CLI::App& app) {
                   "newton: weight of the shape-keeping smoothing term")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
+  cmd->add_flag("!--no-equalize-flips", o.equalize_flips,
+                "Skip the Delaunay flips after each area-equalizing iteration");
   cmd->add_option("--threads", o.threads, "Worker threads (default: all)")
       ->check(CLI::NonNegativeNumber);
   cmd->add_flag("--no-project", a->no_project,
