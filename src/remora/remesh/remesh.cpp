@@ -1085,7 +1085,7 @@ private:
   // tested again on the mesh as the earlier flips left it.
   std::size_t delaunay_flips() {
     const std::size_t n = mesh_.n_edges();
-    std::vector<char>& marked = moves_; // scratch (move_vertices is done with it)
+    std::vector<char>& marked = marked_; // kept between iterations
     marked.assign(n, 0);
     parallel_for(n, options_.threads, [&](std::size_t i) {
       const EdgeHandle e(static_cast<int>(i));
@@ -1295,6 +1295,7 @@ private:
   std::vector<SurfacePoint> reprojected_;         // scratch of reproject_points()
   std::vector<Vec3> placed_;                      // scratch of move_vertices()
   std::vector<char> moves_;                       // scratch of move_vertices()
+  std::vector<char> marked_;                      // scratch of delaunay_flips()
   std::vector<std::array<double, 3>> face_parts_; // scratch of equalize_areas_newton()
   std::vector<double> vertex_areas_;              // scratch of equalize_areas_newton()
   void add_working_properties() {
