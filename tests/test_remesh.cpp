@@ -284,6 +284,14 @@ TEST(Remesh, WithoutProjectionVerticesStayNearTheInput) {
   }
   opt.project = true;
   EXPECT_EQ(remesh(input, opt).report.vertex_distance_max, 0.0);
+  // Split vertices and collapse survivors wait at chord midpoints for the cycle's smoothing to
+  // project them: without any fine-tuning, every vertex must still end on the input, and every
+  // location must evaluate to its vertex.
+  opt.equalize_iterations = 0;
+  const RemeshResult cycles_only = remesh(input, opt);
+  EXPECT_GT(cycles_only.report.splits + cycles_only.report.collapses, 0u);
+  EXPECT_EQ(cycles_only.report.vertex_distance_max, 0.0);
+  expect_sound_output(cycles_only, input);
 }
 
 TEST(Remesh, WithoutTheReportTheMeshIsTheSame) {
