@@ -330,9 +330,13 @@ TEST(Remesh, FineTuningFlipsLeaveADelaunayMesh) {
   const Mesh input = read_mesh(std::string(REMORA_REPO_DATA) + "/bunny.ply").mesh;
   RemeshOptions opt;
   opt.compute_report = false;
-  EXPECT_EQ(non_delaunay_edges(remesh(input, opt).mesh), 0u);
+  const RemeshResult flipped = remesh(input, opt);
+  EXPECT_EQ(non_delaunay_edges(flipped.mesh), 0u);
+  EXPECT_GT(flipped.report.delaunay_flips, 0u);
   opt.equalize_flips = false;
-  EXPECT_GT(non_delaunay_edges(remesh(input, opt).mesh), 20u); // what the flips remove
+  const RemeshResult unflipped = remesh(input, opt);
+  EXPECT_GT(non_delaunay_edges(unflipped.mesh), 20u); // what the flips remove
+  EXPECT_EQ(unflipped.report.delaunay_flips, 0u);
 }
 
 TEST(Remesh, RejectsBadOptions) {

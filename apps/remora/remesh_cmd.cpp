@@ -68,8 +68,10 @@ void print_remesh_report(std::ostream& os, const RemeshReport& r) {
   os << fmt::format("input -> output locations, tracked through every operation: farther than "
                     "the closest point by {:.1e} l on average, {:.1e} l at most\n",
                     r.tracked_excess_mean, r.tracked_excess_max);
-  os << fmt::format("operations: {} splits, {} collapses, {} flips, {} repairs\n",
-                    grouped(r.splits), grouped(r.collapses), grouped(r.flips), grouped(r.repairs));
+  os << fmt::format("operations: {} splits, {} collapses, {} flips, {} repairs; {} Delaunay flips "
+                    "in the fine-tuning\n",
+                    grouped(r.splits), grouped(r.collapses), grouped(r.flips), grouped(r.repairs),
+                    grouped(r.delaunay_flips));
   std::string times;
   for (const auto& [phase, ms] : r.milliseconds) times += fmt::format("{} {:.0f} ms, ", phase, ms);
   if (!times.empty()) times.resize(times.size() - 2);

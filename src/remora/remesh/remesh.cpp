@@ -115,7 +115,7 @@ public:
     timed("equalize", [&] {
       for (int it = 0; it < options_.equalize_iterations; ++it) {
         progress("equalize", it, options_.equalize_iterations);
-        equalize_areas();
+        report.delaunay_flips += equalize_areas();
       }
       if (options_.equalize_iterations > 0)
         report.repairs += repair_bad_triangles(options_.repair_angle_deg);
@@ -1092,12 +1092,13 @@ private:
     });
   }
 
-  void equalize_areas() {
+  // One fine-tuning iteration; returns the number of Delaunay flips it made.
+  std::size_t equalize_areas() {
     if (options_.equalization == Equalization::Gravity)
       equalize_areas_gravity();
     else
       equalize_areas_newton();
-    if (options_.equalize_flips) delaunay_flips();
+    return options_.equalize_flips ? delaunay_flips() : 0;
   }
 
   // Flips every interior edge whose opposite angles sum to more than π (cot α + cot β < 0),
@@ -1374,6 +1375,7 @@ nlohmann::json to_json(const RemeshReport& r) {
           {"splits", r.splits},
           {"collapses", r.collapses},
           {"flips", r.flips},
+          {"delaunay_flips", r.delaunay_flips},
           {"repairs", r.repairs},
           {"milliseconds", r.milliseconds}};
 }

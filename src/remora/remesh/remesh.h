@@ -89,8 +89,9 @@ struct RemeshReport {
   /// largest, relative to the target length), and the share of tracked faces the walk kept.
   double tracked_excess_mean = 0.0, tracked_excess_max = 0.0;
   double tracked_same_face = 0.0;
-  std::size_t splits = 0, collapses = 0, flips = 0;
-  std::size_t repairs = 0; ///< flips and collapses of triangles below repair_angle_deg
+  std::size_t splits = 0, collapses = 0, flips = 0; ///< flips: the cycles' valence flips
+  std::size_t delaunay_flips = 0; ///< flips between fine-tuning iterations (equalize_flips)
+  std::size_t repairs = 0;        ///< flips and collapses of triangles below repair_angle_deg
   /// Wall time per phase in milliseconds ("split", "collapse", "flip", "smooth", "repair",
   /// "equalize", "correspondence", "report", "total").
   std::map<std::string, double> milliseconds;
