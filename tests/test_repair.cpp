@@ -31,8 +31,8 @@ void expect_accounting(const RepairResult& r) {
   const RepairReport& rep = r.report;
   EXPECT_EQ(rep.triangles_in(), rep.faces_loaded + rep.faces_dropped());
   EXPECT_EQ(rep.vertices_in + rep.vertices_added_by_split,
-            rep.unreferenced_vertices + rep.welded_vertices + rep.orphaned_vertices +
-                rep.vertices_loaded);
+            rep.unreferenced_vertices + rep.welded_vertices + rep.near_welded_vertices +
+                rep.orphaned_vertices + rep.vertices_loaded);
   EXPECT_EQ(r.mesh.n_faces(), rep.faces_loaded);
   EXPECT_EQ(r.mesh.n_vertices(), rep.vertices_loaded);
   EXPECT_EQ(r.source_vertex.size(), r.mesh.n_vertices());
@@ -74,6 +74,78 @@ TEST(Repair, WeldsAnStlCubeIntoOneClosedOutwardComponent) {
   EXPECT_TRUE(is_closed(r.mesh));
   EXPECT_NEAR(signed_volume(r.mesh), 1.0, 1e-12);
   EXPECT_EQ(r.report.flipped_faces, 0u);
+}
+
+// featuretype.STL's trap: CAD patches whose seam vertices sit at z = -2.7e-16 on one side and
+// z = 0 on the other. Bit-identical welding leaves a crack along every seam.
+TEST(Repair, WeldsVerticesWithinTheToleranceSoSeamsClose) {
+  PolygonSoup soup = stl_cube();
+  std::size_t moved = 0;
+  for (std::size_t i = 0; i < soup.points.size(); i += 2) // every other facet corner
+    if (soup.points[i][2] == 0) {
+      soup.points[i][2] = -2.7e-16;
+      ++moved;
+    }
+  ASSERT_GT(moved, 0u);
+  const RepairResult r = repair_soup(soup);
+  expect_accounting(r);
+  EXPECT_EQ(r.mesh.n_vertices(), 8u);
+  EXPECT_EQ(r.report.near_welded_vertices, 4u); // each bottom corner exists at both heights
+  EXPECT_TRUE(is_closed(r.mesh));
+  EXPECT_NEAR(signed_volume(r.mesh), 1.0, 1e-12);
+
+  RepairOptions exact;
+  exact.weld_tolerance = 0;
+  const RepairResult cracked = repair_soup(soup, exact);
+  expect_accounting(cracked);
+  EXPECT_EQ(cracked.report.near_welded_vertices, 0u);
+  EXPECT_GE(cracked.mesh.n_vertices(), 12u); // 8 + 4 copies, and pinch splits
+  EXPECT_FALSE(is_closed(cracked.mesh));
+}
+
+// Pairs of triangles whose shared edge is doubled at 0.9 or 1.1 tolerances, at random places
+// (about one pair in ten straddles a hash cell's face): exactly the close copies merge, into
+// the vertex listed first, whose coordinates stay bit for bit.
+TEST(Repair, NearWeldMergesExactlyTheCopiesWithinReach) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  auto random_unit = [&] {
+    Vec3 d(uniform(rng), uniform(rng), uniform(rng));
+    while (d.norm() < 0.1) d = Vec3(uniform(rng), uniform(rng), uniform(rng));
+    return d.normalized();
+  };
+  PolygonSoup soup;
+  // Two far corners fix the bounding box: diagonal 2 sqrt(3) x 10.
+  soup.points = {{-10, -10, -10}, {-10, -9, -10}, {-9, -10, -10},
+                 {10, 10, 10},    {10, 9, 10},    {9, 10, 10}};
+  soup.add_triangle(0, 1, 2);
+  soup.add_triangle(3, 4, 5);
+  const double tol = RepairOptions{}.weld_tolerance * 20 * std::sqrt(3.0);
+  const int pairs = 400;
+  for (int k = 0; k < pairs; ++k) {
+    const bool close = k % 2 == 0;
+    const Vec3 p(5 * uniform(rng), 5 * uniform(rng), 5 * uniform(rng));
+    const Vec3 q = p + Vec3(0.01, 0, 0), r = p + Vec3(0, 0.01, 0), s = p + Vec3(0, 0, -0.01);
+    const double offset = (close ? 0.9 : 1.1) * tol;
+    const auto base = static_cast<std::uint32_t>(soup.points.size());
+    soup.points.insert(soup.points.end(),
+                       {p, q, r, p + offset * random_unit(), q + offset * random_unit(), s});
+    soup.add_triangle(base, base + 1, base + 2);
+    soup.add_triangle(base + 4, base + 3, base + 5);
+  }
+  const RepairResult r = repair_soup(soup);
+  expect_accounting(r);
+  EXPECT_EQ(r.report.near_welded_vertices, static_cast<std::size_t>(pairs)); // 2 per close pair
+  EXPECT_EQ(r.mesh.n_vertices(), 6u + 6u * pairs - pairs);
+  // Every output vertex has the coordinates of the soup vertex it stems from, bit for bit, and
+  // that vertex is the first of its copies.
+  for (auto v : r.mesh.vertices()) {
+    const std::uint32_t src = r.source_vertex[v.idx()];
+    EXPECT_EQ(r.mesh.point(v), soup.points[src]);
+    if (src >= 6 && (src - 6) / 6 % 2 == 0) { // a close pair: its copies 3 and 4 are gone
+      EXPECT_TRUE((src - 6) % 6 != 3 && (src - 6) % 6 != 4) << "a later copy survived";
+    }
+  }
 }
 
 TEST(Repair, OrientsRandomlyWoundFacetsOutward) {

@@ -172,7 +172,8 @@ private:
                                 std::to_string(nv) + " vertices");
   }
 
-  // Steps 1 and 2: unreferenced vertices are dropped, coincident ones merged. vmap_ maps soup
+  // Steps 1 and 2: unreferenced vertices are dropped, coincident ones merged (bit-identical ones
+  // first, then those closer than the tolerance). vmap_ maps soup
   // vertex -> welded vertex (or kNone when unreferenced).
   void weld() {
     const std::size_t nv = soup_.points.size();
@@ -199,6 +200,92 @@ private:
       points_.push_back(soup_.points[i]);
       source_.push_back(static_cast<std::uint32_t>(i));
     }
+    if (options_.weld && options_.weld_tolerance > 0) weld_near();
+  }
+
+  // Step 2, second half: vertices within weld_tolerance x the bounding-box diagonal of an earlier
+  // (distinct) vertex are merged into it. Each vertex joins the first earlier survivor within
+  // reach, so the result follows the file's order and does not depend on hashing. Cells of 64
+  // tolerances: a vertex looks into a neighbouring cell only when it lies within reach of its
+  // face, so almost every vertex costs one lookup.
+  void weld_near() {
+    const std::size_t n = points_.size();
+    if (n < 2) return;
+    Vec3 lo(std::numeric_limits<double>::infinity()), hi(-std::numeric_limits<double>::infinity());
+    for (const Vec3& p : points_) {
+      if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) return;
+      lo.minimize(p);
+      hi.maximize(p);
+    }
+    const double tol = options_.weld_tolerance * (hi - lo).norm();
+    if (!(tol > 0)) return;
+    const double cell = 64 * tol;
+    struct Cell {
+      std::int64_t i, j, k;
+      bool operator==(const Cell& o) const { return i == o.i && j == o.j && k == o.k; }
+    };
+    struct CellHash {
+      std::size_t operator()(const Cell& c) const {
+        std::uint64_t s = std::uint64_t(c.i) * 0x9E3779B97F4A7C15ULL;
+        s ^= std::uint64_t(c.j) * 0xBF58476D1CE4E5B9ULL + (s << 6) + (s >> 2);
+        s ^= std::uint64_t(c.k) * 0x94D049BB133111EBULL + (s << 6) + (s >> 2);
+        return static_cast<std::size_t>(s ^ (s >> 31));
+      }
+    };
+    std::unordered_map<Cell, std::uint32_t, CellHash> head; // cell -> its last survivor
+    head.reserve(n);
+    std::vector<std::uint32_t> next(n, kNone); // survivors of a cell, newest first
+    std::vector<std::uint32_t> remap(n);
+    std::vector<Vec3> kept_points;
+    std::vector<std::uint32_t> kept_source;
+    kept_points.reserve(n);
+    kept_source.reserve(n);
+    std::vector<std::uint32_t> kept_index; // survivor (old index) -> new index
+    kept_index.assign(n, kNone);
+    for (std::uint32_t v = 0; v < n; ++v) {
+      const Vec3 q = (points_[v] - lo) / cell;
+      const Cell c{static_cast<std::int64_t>(std::floor(q[0])),
+                   static_cast<std::int64_t>(std::floor(q[1])),
+                   static_cast<std::int64_t>(std::floor(q[2]))};
+      // Per axis: this cell, and the neighbour whose face lies within reach.
+      std::array<std::array<int, 2>, 3> offsets{};
+      std::array<int, 3> count{};
+      const std::int64_t base[3] = {c.i, c.j, c.k};
+      for (int a = 0; a < 3; ++a) {
+        const double frac = (q[a] - static_cast<double>(base[a])) * cell;
+        offsets[a][count[a]++] = 0;
+        if (frac < tol) offsets[a][count[a]++] = -1;
+        else if (cell - frac < tol) offsets[a][count[a]++] = 1;
+      }
+      std::uint32_t found = kNone;
+      for (int x = 0; x < count[0]; ++x)
+        for (int y = 0; y < count[1]; ++y)
+          for (int z = 0; z < count[2]; ++z) {
+            auto it = head.find({c.i + offsets[0][x], c.j + offsets[1][y], c.k + offsets[2][z]});
+            if (it == head.end()) continue;
+            for (std::uint32_t s = it->second; s != kNone; s = next[s])
+              if (s < found && (points_[s] - points_[v]).sqrnorm() <= tol * tol) found = s;
+          }
+      if (found != kNone) {
+        remap[v] = kept_index[found];
+        ++report_.near_welded_vertices;
+        continue;
+      }
+      auto [it, inserted] = head.try_emplace(c, v);
+      if (!inserted) {
+        next[v] = it->second;
+        it->second = v;
+      }
+      kept_index[v] = static_cast<std::uint32_t>(kept_points.size());
+      remap[v] = kept_index[v];
+      kept_points.push_back(points_[v]);
+      kept_source.push_back(source_[v]);
+    }
+    if (kept_points.size() == n) return;
+    for (std::uint32_t& m : vmap_)
+      if (m != kNone) m = remap[m];
+    points_ = std::move(kept_points);
+    source_ = std::move(kept_source);
   }
 
   // Step 3.

@@ -2,7 +2,9 @@
 //
 // Steps, each counted in RepairReport, in this order:
 //  1. drop vertices no polygon references;
-//  2. weld coincident vertices (bit-identical coordinates, -0 == +0; STL shares no vertices);
+//  2. weld coincident vertices (bit-identical coordinates, -0 == +0; STL shares no vertices),
+//     then vertices closer than weld_tolerance x the bounding-box diagonal (CAD exports whose
+//     patches meet at 1e-16 instead of 0 would otherwise keep cracks along every seam);
 //  3. triangulate polygons with more than three corners (ear clipping in the best-fit plane);
 //  4. drop triangles with a repeated vertex (after welding; PLY strip "swap" triangles), and
 //     duplicate triangles (the same three vertices in any order; the first is kept, or none when
@@ -28,7 +30,11 @@
 namespace remora {
 
 struct RepairOptions {
-  bool weld = true;    ///< weld bit-identical vertices
+  bool weld = true;    ///< weld bit-identical vertices, and near ones (weld_tolerance)
+  /// Vertices closer than this x the bounding-box diagonal are merged into the first of them in
+  /// file order (0: bit-identical ones only). 1e-10 is far below any real feature and far above
+  /// double rounding at the coordinates' scale.
+  double weld_tolerance = 1e-10;
   bool orient = true;  ///< make the orientation consistent per component
   bool outward = true; ///< closed components: normals point outward (positive signed volume)
 };
@@ -39,7 +45,8 @@ struct RepairReport {
   std::size_t polygons_in = 0; ///< soup polygons (faces as stored in the file)
   // Vertices.
   std::size_t unreferenced_vertices = 0; ///< referenced by no polygon; dropped
-  std::size_t welded_vertices = 0;       ///< merged into a coincident vertex
+  std::size_t welded_vertices = 0;       ///< merged into a bit-identical vertex
+  std::size_t near_welded_vertices = 0;  ///< merged into a vertex within the weld tolerance
   std::size_t split_vertices = 0;        ///< non-manifold vertices (more than one fan), each split
   std::size_t vertices_added_by_split = 0; ///< copies created by splitting (and by detaching)
   std::size_t orphaned_vertices = 0; ///< left without a triangle once dropped ones were removed
@@ -64,7 +71,8 @@ struct RepairReport {
   std::size_t faces_loaded = 0;
 
   std::size_t triangles_in() const { return polygons_in + triangles_added_by_triangulation; }
-  // vertices_in = unreferenced + welded + orphaned + vertices_loaded - vertices_added_by_split.
+  // vertices_in = unreferenced + welded + near_welded + orphaned + vertices_loaded
+  //               - vertices_added_by_split.
   std::size_t faces_dropped() const {
     return dropped_repeated_vertex + dropped_duplicate + dropped_flap + dropped_degenerate_polygon;
   }

@@ -17,6 +17,7 @@ std::vector<std::string> describe(const RepairReport& r) {
   };
   add(r.unreferenced_vertices, "unreferenced vertices dropped");
   add(r.welded_vertices, "coincident vertices welded");
+  add(r.near_welded_vertices, "vertices welded to a vertex within the weld tolerance");
   if (r.polygons_triangulated > 0)
     lines.push_back(grouped(r.polygons_triangulated) + " polygons triangulated into " +
                     grouped(r.polygons_triangulated + r.triangles_added_by_triangulation) +
@@ -43,6 +44,7 @@ nlohmann::json to_json(const RepairReport& r) {
           {"triangles_in", r.triangles_in()},
           {"unreferenced_vertices", r.unreferenced_vertices},
           {"welded_vertices", r.welded_vertices},
+          {"near_welded_vertices", r.near_welded_vertices},
           {"orphaned_vertices", r.orphaned_vertices},
           {"split_vertices", r.split_vertices},
           {"vertices_added_by_split", r.vertices_added_by_split},
