@@ -254,8 +254,10 @@ private:
       for (int a = 0; a < 3; ++a) {
         const double frac = (q[a] - static_cast<double>(base[a])) * cell;
         offsets[a][count[a]++] = 0;
-        if (frac < tol) offsets[a][count[a]++] = -1;
-        else if (cell - frac < tol) offsets[a][count[a]++] = 1;
+        if (frac < tol)
+          offsets[a][count[a]++] = -1;
+        else if (cell - frac < tol)
+          offsets[a][count[a]++] = 1;
       }
       std::uint32_t found = kNone;
       for (int x = 0; x < count[0]; ++x)

@@ -30,7 +30,7 @@
 namespace remora {
 
 struct RepairOptions {
-  bool weld = true;    ///< weld bit-identical vertices, and near ones (weld_tolerance)
+  bool weld = true; ///< weld bit-identical vertices, and near ones (weld_tolerance)
   /// Vertices closer than this x the bounding-box diagonal are merged into the first of them in
   /// file order (0: bit-identical ones only). 1e-10 is far below any real feature and far above
   /// double rounding at the coordinates' scale.
