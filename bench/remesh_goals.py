@@ -24,7 +24,7 @@ MESHES = [
     ("bunny (5 holes)", "scans/bunny.ply"),
     ("conrod (CAD)", "cad/conrod.stl"),
     ("gears (CAD, 7 bodies)", "cad/gears.stl"),
-    ("featuretype (CAD, cracks)", "cad/featuretype.STL"),
+    ("featuretype (CAD, seams welded)", "cad/featuretype.STL"),
     ("blade (CAD needles)", "cad/blade.off"),
 ]
 
