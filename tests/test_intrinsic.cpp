@@ -97,7 +97,8 @@ TEST(LowPass, KeepsConstantsAndDampsShortWavelengthsMore) {
   }
   const Eigen::MatrixXd g = filter.apply(f);
   EXPECT_LT((g.col(0).array() - 1.0).abs().maxCoeff(), 1e-8);
-  // Interior rows only (the boundary has the natural condition).
+  // Rows away from the boundary (its loop is filtered as a curve, whose sides x = 0 and x = 1
+  // see constants: a boundary layer about σ wide).
   double long_ratio = 0, short_ratio = 0;
   int count = 0;
   for (Eigen::Index i = 0; i < n; ++i)
@@ -121,6 +122,46 @@ TEST(LowPass, KeepsConstantsAndDampsShortWavelengthsMore) {
   LowPassFilter identity(m, options);
   EXPECT_EQ(identity.apply(f), f);
   EXPECT_THROW(identity.apply(Eigen::MatrixXd::Zero(3, 3)), InvalidArgument);
+}
+
+// A plane's boundary stays where it is: the loops are filtered as curves and the interior takes
+// them as Dirichlet values. With the surface operator's natural condition, the sides moved inward
+// by about σ (AcrossRiver: 2 mean edge lengths at σ = 2). Noise along the boundary is damped as
+// in the interior.
+TEST(LowPass, KeepsAPlanesBoundaryAndSmoothsAlongIt) {
+  Mesh m = make_grid(40, 40, 1.0, 1.0);
+  Eigen::MatrixXd p = positions_matrix(m);
+  const double wavelength = 3.0 / 40; // 3 edges
+  Eigen::MatrixXd noisy = p;
+  for (Eigen::Index i = 0; i < p.rows(); ++i)
+    noisy(i, 2) = 0.01 * std::cos(2 * M_PI * p(i, 0) / wavelength) *
+                  std::cos(2 * M_PI * p(i, 1) / wavelength);
+  LowPassFilter filter(m, {.smoothing = 2.0});
+  const double sigma = filter.stats().sigma;
+  // Flat input: every vertex away from the four corners stays put (linear precision inside,
+  // straight evenly spaced sides on the boundary).
+  const Eigen::MatrixXd flat = filter.apply(p);
+  double side_shift = 0, inner_shift = 0, noise_in = 0, noise_out = 0;
+  const Eigen::MatrixXd smoothed = filter.apply(noisy);
+  for (Eigen::Index i = 0; i < p.rows(); ++i) {
+    const double x = p(i, 0), y = p(i, 1);
+    const double corner = std::min(
+        std::hypot(x, y),
+        std::min(std::hypot(1 - x, y), std::min(std::hypot(x, 1 - y), std::hypot(1 - x, 1 - y))));
+    if (corner < 8 * sigma) continue;
+    const bool side = x == 0 || x == 1 || y == 0 || y == 1;
+    const double shift = (flat.row(i) - p.row(i)).norm();
+    (side ? side_shift : inner_shift) = std::max(side ? side_shift : inner_shift, shift);
+    if (side) {
+      noise_in = std::max(noise_in, std::abs(noisy(i, 2)));
+      noise_out = std::max(noise_out, std::abs(smoothed(i, 2)));
+    }
+  }
+  EXPECT_LT(side_shift, 1e-3 * sigma);
+  EXPECT_LT(inner_shift, 1e-3 * sigma);
+  ASSERT_GT(noise_in, 0.009);
+  // The curve filter's factor for this wavelength, 1 / (1 + (2πσ/λ)²), is about 0.05.
+  EXPECT_LT(noise_out, 0.15 * noise_in);
 }
 
 } // namespace

@@ -5,6 +5,13 @@
 // needles and zero-area faces, where the mesh's own cotan weights are huge or negative and would
 // make the system indefinite; docs/editing.md says why this choice and what it measured.
 //
+// Boundaries: a boundary loop is filtered as a curve, by the same step with the curve's own
+// operator (edge weights 1/length, mass half the adjacent boundary lengths), and the interior then
+// takes the filtered loops as Dirichlet values. With the surface operator's natural condition
+// instead, the cotan Laplacian pulls every boundary vertex inward in the tangent plane: by 2 mean
+// edge lengths on heightfield/AcrossRiver.stl at σ = 2, where the first rows of triangles folded
+// (docs/editing.md). A straight, evenly sampled boundary of a plane now stays where it is.
+//
 // Strength: t = σ², σ = smoothing × the mesh's length scale (its mean edge length unless needles
 // inflate it: geometry/measures.h, length_scale()). A Laplacian eigenfunction of
 // wavelength λ is scaled by 1 / (1 + (2πσ/λ)²) per step: wavelengths below 2πσ lose at least half.
@@ -13,8 +20,10 @@
 
 #include <cstddef>
 #include <memory>
+#include <vector>
 
 #include <Eigen/Core>
+#include <Eigen/SparseCore>
 
 #include "remora/geometry/intrinsic.h"
 #include "remora/linalg/solver.h"
@@ -56,8 +65,13 @@ public:
 
 private:
   Eigen::Index n_ = 0;
-  Eigen::VectorXd mass_;
-  std::unique_ptr<Solver> solver_; // null when smoothing == 0
+  // Interior vertices (all of them on a closed mesh), then boundary vertices: their row indices.
+  std::vector<Eigen::Index> interior_, boundary_;
+  Eigen::VectorXd mass_, boundary_mass_;
+  Eigen::SparseMatrix<double> coupling_;    // t W restricted to interior rows, boundary columns
+  std::unique_ptr<Solver> solver_;          // interior system; null when smoothing == 0
+  std::unique_ptr<Solver> boundary_solver_; // the loops' curve system; null without boundary
+  bool solved_ = false;                     // false: smoothing == 0, the identity
   int steps_ = 1;
   LowPassStats stats_;
 };
