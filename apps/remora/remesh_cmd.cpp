@@ -69,9 +69,9 @@ void print_remesh_report(std::ostream& os, const RemeshReport& r) {
                     "the closest point by {:.1e} l on average, {:.1e} l at most\n",
                     r.tracked_excess_mean, r.tracked_excess_max);
   os << fmt::format("operations: {} splits, {} collapses, {} flips, {} repairs; {} Delaunay flips "
-                    "in the fine-tuning\n",
+                    "in the fine-tuning, {} of its moves shortened against slivers\n",
                     grouped(r.splits), grouped(r.collapses), grouped(r.flips), grouped(r.repairs),
-                    grouped(r.delaunay_flips));
+                    grouped(r.delaunay_flips), grouped(r.guarded_moves));
   std::string times;
   for (const auto& [phase, ms] : r.milliseconds) times += fmt::format("{} {:.0f} ms, ", phase, ms);
   if (!times.empty()) times.resize(times.size() - 2);
@@ -120,6 +120,11 @@ void add_remesh_command(CLI::App& app) {
       ->capture_default_str();
   cmd->add_flag("!--no-equalize-flips", o.equalize_flips,
                 "Skip the Delaunay flips after each area-equalizing iteration");
+  cmd->add_option("--guard-angle", o.equalize_guard_deg,
+                  "newton: shorten fine-tuning moves that would bring a face below this angle "
+                  "(degrees; 0 = off)")
+      ->check(CLI::Range(0.0, 60.0))
+      ->capture_default_str();
   cmd->add_option("--threads", o.threads, "Worker threads (default: all)")
       ->check(CLI::NonNegativeNumber);
   cmd->add_flag("--no-project", a->no_project,

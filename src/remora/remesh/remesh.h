@@ -48,6 +48,11 @@ struct RemeshOptions {
   /// After every fine-tuning iteration, flip the edges whose opposite angles sum to more than π
   /// (intrinsic Delaunay flips): the fine-tuning then costs less triangle shape (docs/remesh.md).
   bool equalize_flips = true;
+  /// Newton only: a fine-tuning move that would bring a face around the vertex (after its
+  /// placement on the input) below this angle, and below the smallest angle around it now, is
+  /// halved, twice at most, then dropped. 5 degrees above repair_angle_deg leaves room for the
+  /// neighbours, which move at the same time (docs/remesh.md). 0 turns the guard off.
+  double equalize_guard_deg = 30.0;
   /// Project moved vertices back onto the input surface (true), or only keep updates in the
   /// tangent plane (the paper's cheaper variant).
   bool project = true;
@@ -91,6 +96,7 @@ struct RemeshReport {
   double tracked_same_face = 0.0;
   std::size_t splits = 0, collapses = 0, flips = 0; ///< flips: the cycles' valence flips
   std::size_t delaunay_flips = 0; ///< flips between fine-tuning iterations (equalize_flips)
+  std::size_t guarded_moves = 0;  ///< fine-tuning moves halved or dropped (equalize_guard_deg)
   std::size_t repairs = 0;        ///< flips and collapses of triangles below repair_angle_deg
   /// Wall time per phase in milliseconds ("split", "collapse", "flip", "smooth", "repair",
   /// "equalize", "correspondence", "report", "total").
