@@ -80,7 +80,8 @@ public:
         2 * input_.n_faces();
     live_faces_ = mesh_.n_faces();
     lo2_ = (0.8 * length_) * (0.8 * length_);
-    cos_guard_ = std::cos(options_.equalize_guard_deg * M_PI / 180.0);
+    guard_rad_ = options_.equalize_guard_deg * M_PI / 180.0;
+    cos_guard_ = std::cos(guard_rad_);
     hi_ = 4.0 / 3.0 * length_;
     hi2_ = hi_ * hi_;
 
@@ -1066,43 +1067,96 @@ private:
   // about four edges around (smoothed fertility's arm) the projection, not the tangential step,
   // is what squeezed an edge to 0.31 l.
   template <class Target>
-  void move_vertices(Target&& target, bool guard = false) {
+  void move_vertices(Target&& target) {
+    move_vertices_placing([&](VertexHandle v, Vec3& out) {
+      Vec3 g;
+      if (!target(v, g)) return Placed::No;
+      out = relocate(v, g, v);
+      return Placed::Moved;
+    });
+  }
+
+  // What a placing target did with its vertex.
+  enum class Placed : char { No, Moved, Shortened, Dropped };
+
+  // The same loop for a target that places its vertex on the input itself (`out`), so that it
+  // can test the placed position (the fine-tuning's sliver guard).
+  template <class Place>
+  void move_vertices_placing(Place&& place) {
     const std::size_t n = mesh_.n_vertices();
     std::vector<Vec3>& placed = placed_; // kept between calls: no fresh pages each time
-    std::vector<char>& moves = moves_;
+    std::vector<Placed>& moves = moves_;
     placed.resize(n);
-    moves.assign(n, 0);
+    moves.assign(n, Placed::No);
     parallel_for(n, options_.threads, [&](std::size_t i) {
       const VertexHandle v(static_cast<int>(i));
       if (mesh_.status(v).deleted() || kind(v) == Kind::Corner || mesh_.is_isolated(v)) return;
-      Vec3 g;
-      if (!target(v, g)) return;
-      if (!guard) {
-        placed[i] = relocate(v, g, v);
-        moves[i] = 1;
-        return;
-      }
-      // The target left in guard_floor_ the cosine no face around v may exceed, and in
-      // guard_safe_ how far v may move without any angle around it reaching that limit.
-      const Vec3 p = mesh_.point(v);
-      const SurfacePoint before = loc(v);
-      const double floor = guard_floor_[i], safe = guard_safe_[i];
-      for (int tries = 0; tries < 3; ++tries, g = (p + g) * 0.5) {
-        placed[i] = relocate(v, g, v);
-        if ((placed[i] - p).sqrnorm() <= safe * safe || ring_within(v, placed[i], floor)) {
-          moves[i] = tries == 0 ? 1 : 2;
-          return;
-        }
-      }
-      loc(v) = before; // stays where it is
-      moves[i] = 3;
+      moves[i] = place(v, placed[i]);
     });
     for (std::size_t i = 0; i < n; ++i) {
-      if (moves[i] == 1 || moves[i] == 2)
+      if (moves[i] == Placed::Moved || moves[i] == Placed::Shortened)
         mesh_.set_point(VertexHandle(static_cast<int>(i)), placed[i]);
-      guarded_ += moves[i] >= 2 ? 1 : 0;
+      guarded_ += moves[i] == Placed::Shortened || moves[i] == Placed::Dropped ? 1 : 0;
     }
     reproject_points();
+  }
+
+  // A vertex's one-ring as the fine-tuning reads it: ring[j] = to(h_j) for its outgoing
+  // halfedges h_j, face j = (v, ring[j], ring[third[j]]) when face[j] is valid.
+  struct Ring {
+    static constexpr int kMax = 64;
+    VertexHandle ring[kMax];
+    FaceHandle face[kMax];
+    int third[kMax];
+    int k = 0;
+  };
+
+  // Is the cosine of the smallest angle of every face of `r`, with its centre at q, at most
+  // `limit` (in [0, 1])? No square root: the cosine opposite the shortest side s,
+  // (e1 + e2 - s) / (2 sqrt(e1 e2)) in squared lengths, has a non-negative numerator.
+  bool ring_within(const Ring& r, const Vec3& q, double limit) const {
+    const double limit2 = 4 * limit * limit;
+    for (int j = 0; j < r.k; ++j) {
+      if (!r.face[j].is_valid()) continue;
+      const Vec3& a = mesh_.point(r.ring[j]);
+      const Vec3& b = mesh_.point(r.ring[r.third[j]]);
+      const double x = (a - q).sqrnorm(), y = (b - q).sqrnorm(), z = (a - b).sqrnorm();
+      double s = x, e1 = y, e2 = z;
+      if (e1 < s) std::swap(s, e1);
+      if (e2 < s) std::swap(s, e2);
+      const double numerator = e1 + e2 - s;
+      if (numerator * numerator > limit2 * e1 * e2) return false;
+    }
+    return true;
+  }
+
+  // The sliver guard (equalize_guard_deg): places v at `goal`, or halfway back, twice at most,
+  // so that no face of its ring falls below the guard angle, nor below the ring's smallest angle
+  // where that is smaller already; else v stays. Tested after the placement on the input: on a
+  // part about four edges around (the smoothed fertility's arm) the projection, not the
+  // tangential step, is what squeezed an edge to 0.31 l.
+  Placed guarded_place(VertexHandle v, Vec3 goal, const Ring& r, Vec3& out) {
+    const Vec3 p = mesh_.point(v);
+    // The ring's smallest angle now (face_cos_, from the iteration's face loop), and how far v
+    // may move before any angle of its ring can reach the limit: moving v by δ turns each angle
+    // of a face (v, a, b) by at most 2|δ| / (r − |δ|), r the shorter of |va| and |vb|.
+    double worst = -1, shortest2 = std::numeric_limits<double>::max();
+    for (int j = 0; j < r.k; ++j) {
+      shortest2 = std::min(shortest2, (mesh_.point(r.ring[j]) - p).sqrnorm());
+      if (r.face[j].is_valid())
+        worst = std::max(worst, face_cos_[static_cast<std::size_t>(r.face[j].idx())]);
+    }
+    const double limit = std::max(worst, cos_guard_);
+    const double margin = std::acos(std::clamp(worst, -1.0, 1.0)) - guard_rad_;
+    const double safe = margin > 0 ? margin * std::sqrt(shortest2) / (2 + margin) : 0.0;
+    const SurfacePoint before = loc(v);
+    for (int tries = 0; tries < 3; ++tries, goal = (p + goal) * 0.5) {
+      out = relocate(v, goal, v);
+      if ((out - p).sqrnorm() <= safe * safe || ring_within(r, out, limit))
+        return tries == 0 ? Placed::Moved : Placed::Shortened;
+    }
+    loc(v) = before;
+    return Placed::Dropped;
   }
 
   // Where a boundary vertex goes: the midpoint of its two boundary neighbours, relaxed by
@@ -1227,17 +1281,15 @@ private:
     std::vector<std::array<double, 3>>& face_parts = face_parts_; // kept between iterations
     face_parts.resize(nf);
     const bool guard = options_.equalize_guard_deg > 0;
-    if (guard) {
-      guard_floor_.resize(mesh_.n_vertices());
-      guard_safe_.resize(mesh_.n_vertices());
-    }
-    const double guard_rad = options_.equalize_guard_deg * M_PI / 180.0;
+    if (guard) face_cos_.resize(nf); // the faces' smallest-angle cosines, for the guard
+
     parallel_for(nf, options_.threads, [&](std::size_t i) {
       const FaceHandle f(static_cast<int>(i));
       if (mesh_.status(f).deleted()) return;
       const auto fv = face_vertices(mesh_, f);
-      face_parts[i] =
-          triangle_mixed_areas(mesh_.point(fv[0]), mesh_.point(fv[1]), mesh_.point(fv[2]));
+      const Vec3 &a = mesh_.point(fv[0]), &b = mesh_.point(fv[1]), &c = mesh_.point(fv[2]);
+      face_parts[i] = triangle_mixed_areas(a, b, c);
+      if (guard) face_cos_[i] = smallest_angle_cos(a, b, c);
     });
     std::vector<double>& area = vertex_areas_;
     area.assign(mesh_.n_vertices(), 0.0);
@@ -1257,145 +1309,111 @@ private:
     if (count == 0) return;
     const double target = sum / static_cast<double>(count);
     const double eps = 1e-4 * length_;
-    move_vertices(
-        [&](VertexHandle v, Vec3& goal) {
-          if (kind(v) != Kind::Interior) return false;
-          const Vec3 p = mesh_.point(v);
-          // The one-ring: ring[j] = to(h_j); face j = (v, ring[j], ring[third[j]]) when it exists.
-          constexpr int kMax = 64;
-          VertexHandle ring[kMax];
-          FaceHandle face[kMax];
-          int third[kMax];
-          int k = 0;
-          for (auto h : mesh_.voh_range(v)) {
-            if (k == kMax) return false;
-            ring[k] = mesh_.to_vertex_handle(h);
-            face[k] = mesh_.face_handle(h);
-            ++k;
-          }
-          if (k < 3) return false;
-          // Next to the boundary (which does not move here) the area term would squeeze the
-          // boundary triangles: keep to plain tangential smoothing there.
-          bool near_boundary = false;
-          for (int j = 0; j < k; ++j) near_boundary |= kind(ring[j]) != Kind::Interior;
-          // The circulator turns one way: the third corner of face j is ring[j + 1] or ring[j - 1].
-          const HalfedgeHandle h0 = *mesh_.cvoh_begin(v);
-          const VertexHandle c0 = mesh_.to_vertex_handle(mesh_.next_halfedge_handle(h0));
-          const int turn = c0 == ring[1] ? 1 : k - 1;
-          Vec3 centroid(0, 0, 0), normal(0, 0, 0);
-          for (int j = 0; j < k; ++j) {
-            third[j] = (j + turn) % k;
-            centroid += mesh_.point(ring[j]);
-            if (face[j].is_valid())
-              normal += OpenMesh::cross(mesh_.point(ring[j]) - p, mesh_.point(ring[third[j]]) - p);
-          }
-          centroid /= k;
-          const double normal_length = normal.norm();
-          if (!(normal_length > 0)) return false;
-          if (guard) {
-            // Moving v by δ turns each angle of a face (v, a, b) by at most 2|δ| / (r − |δ|), r the
-            // shorter of |va| and |vb|: within the margin of the ring's smallest angle over the
-            // guard angle, no face needs testing.
-            double worst = cos_guard_, shortest2 = std::numeric_limits<double>::max();
-            for (int j = 0; j < k; ++j) {
-              shortest2 = std::min(shortest2, (mesh_.point(ring[j]) - p).sqrnorm());
-              if (face[j].is_valid())
-                worst = std::max(worst, smallest_angle_cos(p, mesh_.point(ring[j]),
-                                                           mesh_.point(ring[third[j]])));
-            }
-            const double margin = std::acos(std::min(worst, 1.0)) - guard_rad;
-            const auto i = static_cast<std::size_t>(v.idx());
-            guard_floor_[i] = worst;
-            guard_safe_[i] = margin > 0 ? margin * std::sqrt(shortest2) / (2 + margin) : 0.0;
-          }
-          const Vec3 n = normal / normal_length;
-          if (near_boundary) {
-            Vec3 u = centroid - p;
-            u -= n * OpenMesh::dot(n, u);
-            goal = p + u * options_.lambda;
-            return true;
-          }
-          // Mixed-area parts of v (index k) and of each ring vertex from the faces around v: at the
-          // current position from face_parts, for v moved to q recomputed.
-          double base[kMax + 1] = {}, moved[kMax + 1], d1[kMax + 1], d2[kMax + 1];
-          for (int j = 0; j < k; ++j) {
-            if (!face[j].is_valid()) continue;
-            const auto fv = face_vertices(mesh_, face[j]);
-            const auto& part = face_parts[static_cast<std::size_t>(face[j].idx())];
-            for (int c = 0; c < 3; ++c)
-              base[fv[c] == v ? k : fv[c] == ring[j] ? j : third[j]] += part[c];
-          }
-          auto parts = [&](const Vec3& q, double* out) {
-            for (int j = 0; j <= k; ++j) out[j] = 0;
-            for (int j = 0; j < k; ++j) {
-              if (!face[j].is_valid()) continue;
-              const auto m =
-                  triangle_mixed_areas(q, mesh_.point(ring[j]), mesh_.point(ring[third[j]]));
-              out[k] += m[0];
-              out[j] += m[1];
-              out[third[j]] += m[2];
-            }
-          };
-          Vec3 t1 = OpenMesh::cross(n, std::abs(n[0]) < 0.9 ? Vec3(1, 0, 0) : Vec3(0, 1, 0));
-          t1.normalize();
-          const Vec3 t2 = OpenMesh::cross(n, t1);
-          for (int axis = 0; axis < 2; ++axis) {
-            const Vec3 t = axis == 0 ? t1 : t2;
-            double* d = axis == 0 ? d1 : d2;
-            parts(p + t * eps, moved);
-            for (int j = 0; j <= k; ++j) d[j] = (moved[j] - base[j]) / eps;
-          }
-          // Residuals: the ring's interior vertices and v itself (index k).
-          Eigen::Matrix2d jtj = Eigen::Matrix2d::Zero();
-          Eigen::Vector2d jtr = Eigen::Vector2d::Zero();
-          for (int j = 0; j <= k; ++j) {
-            const VertexHandle w = j == k ? v : ring[j];
-            if (kind(w) != Kind::Interior) continue;
-            const Eigen::Vector2d row(d1[j], d2[j]);
-            jtj += row * row.transpose();
-            jtr += row * (area[static_cast<std::size_t>(w.idx())] - target);
-          }
-          const Vec3 off = p - centroid;
-          const double mu = options_.equalize_smoothing * 0.5 * jtj.trace();
-          jtj(0, 0) += mu;
-          jtj(1, 1) += mu;
-          jtr += mu * Eigen::Vector2d(OpenMesh::dot(off, t1), OpenMesh::dot(off, t2));
-          if (!(jtj.determinant() > 0)) return false;
-          const Eigen::Vector2d step = -jtj.inverse() * jtr * options_.lambda;
-          Vec3 d = t1 * step[0] + t2 * step[1];
-          // Never move by more than a fraction of the target length in one iteration.
-          const double cap = 0.2 * length_;
-          if (d.norm() > cap) d *= cap / d.norm();
-          goal = p + d;
-          return true;
-        },
-        /*guard=*/options_.equalize_guard_deg > 0);
-  }
-
-  // Is the cosine of the smallest angle of every face around v, with v at q, at most `limit`
-  // (in [0, 1])? No square root: the cosine opposite the shortest side s, (e1 + e2 - s) /
-  // (2 sqrt(e1 e2)) in squared lengths, has a non-negative numerator.
-  bool ring_within(VertexHandle v, const Vec3& q, double limit) const {
-    const double limit2 = 4 * limit * limit;
-    for (auto h : mesh_.voh_range(v)) {
-      if (mesh_.is_boundary(h)) continue;
-      const Vec3& a = mesh_.point(mesh_.to_vertex_handle(h));
-      const Vec3& b = mesh_.point(mesh_.to_vertex_handle(mesh_.next_halfedge_handle(h)));
-      if (smallest_angle_cos_exceeds((a - q).sqrnorm(), (b - q).sqrnorm(), (a - b).sqrnorm(),
-                                     limit2))
-        return false;
-    }
-    return true;
-  }
-
-  // With x, y, z a triangle's squared side lengths: cos(smallest angle) > limit, limit2 being
-  // 4 limit² (limit >= 0).
-  static bool smallest_angle_cos_exceeds(double x, double y, double z, double limit2) {
-    double s = x, e1 = y, e2 = z;
-    if (e1 < s) std::swap(s, e1);
-    if (e2 < s) std::swap(s, e2);
-    const double numerator = e1 + e2 - s;
-    return numerator * numerator > limit2 * e1 * e2;
+    auto newton_goal = [&](VertexHandle v, Vec3& goal, Ring& r) {
+      if (kind(v) != Kind::Interior) return false;
+      const Vec3 p = mesh_.point(v);
+      // The one-ring: ring[j] = to(h_j); face j = (v, ring[j], ring[third[j]]) when it exists.
+      constexpr int kMax = Ring::kMax;
+      VertexHandle* ring = r.ring;
+      FaceHandle* face = r.face;
+      int* third = r.third;
+      int& k = r.k;
+      k = 0;
+      for (auto h : mesh_.voh_range(v)) {
+        if (k == kMax) return false;
+        ring[k] = mesh_.to_vertex_handle(h);
+        face[k] = mesh_.face_handle(h);
+        ++k;
+      }
+      if (k < 3) return false;
+      // Next to the boundary (which does not move here) the area term would squeeze the
+      // boundary triangles: keep to plain tangential smoothing there.
+      bool near_boundary = false;
+      for (int j = 0; j < k; ++j) near_boundary |= kind(ring[j]) != Kind::Interior;
+      // The circulator turns one way: the third corner of face j is ring[j + 1] or ring[j - 1].
+      const HalfedgeHandle h0 = *mesh_.cvoh_begin(v);
+      const VertexHandle c0 = mesh_.to_vertex_handle(mesh_.next_halfedge_handle(h0));
+      const int turn = c0 == ring[1] ? 1 : k - 1;
+      Vec3 centroid(0, 0, 0), normal(0, 0, 0);
+      for (int j = 0; j < k; ++j) {
+        third[j] = (j + turn) % k;
+        centroid += mesh_.point(ring[j]);
+        if (face[j].is_valid())
+          normal += OpenMesh::cross(mesh_.point(ring[j]) - p, mesh_.point(ring[third[j]]) - p);
+      }
+      centroid /= k;
+      const double normal_length = normal.norm();
+      if (!(normal_length > 0)) return false;
+      const Vec3 n = normal / normal_length;
+      if (near_boundary) {
+        Vec3 u = centroid - p;
+        u -= n * OpenMesh::dot(n, u);
+        goal = p + u * options_.lambda;
+        return true;
+      }
+      // Mixed-area parts of v (index k) and of each ring vertex from the faces around v: at the
+      // current position from face_parts, for v moved to q recomputed.
+      double base[kMax + 1] = {}, moved[kMax + 1], d1[kMax + 1], d2[kMax + 1];
+      for (int j = 0; j < k; ++j) {
+        if (!face[j].is_valid()) continue;
+        const auto fv = face_vertices(mesh_, face[j]);
+        const auto& part = face_parts[static_cast<std::size_t>(face[j].idx())];
+        for (int c = 0; c < 3; ++c)
+          base[fv[c] == v ? k : fv[c] == ring[j] ? j : third[j]] += part[c];
+      }
+      auto parts = [&](const Vec3& q, double* out) {
+        for (int j = 0; j <= k; ++j) out[j] = 0;
+        for (int j = 0; j < k; ++j) {
+          if (!face[j].is_valid()) continue;
+          const auto m = triangle_mixed_areas(q, mesh_.point(ring[j]), mesh_.point(ring[third[j]]));
+          out[k] += m[0];
+          out[j] += m[1];
+          out[third[j]] += m[2];
+        }
+      };
+      Vec3 t1 = OpenMesh::cross(n, std::abs(n[0]) < 0.9 ? Vec3(1, 0, 0) : Vec3(0, 1, 0));
+      t1.normalize();
+      const Vec3 t2 = OpenMesh::cross(n, t1);
+      for (int axis = 0; axis < 2; ++axis) {
+        const Vec3 t = axis == 0 ? t1 : t2;
+        double* d = axis == 0 ? d1 : d2;
+        parts(p + t * eps, moved);
+        for (int j = 0; j <= k; ++j) d[j] = (moved[j] - base[j]) / eps;
+      }
+      // Residuals: the ring's interior vertices and v itself (index k).
+      Eigen::Matrix2d jtj = Eigen::Matrix2d::Zero();
+      Eigen::Vector2d jtr = Eigen::Vector2d::Zero();
+      for (int j = 0; j <= k; ++j) {
+        const VertexHandle w = j == k ? v : ring[j];
+        if (kind(w) != Kind::Interior) continue;
+        const Eigen::Vector2d row(d1[j], d2[j]);
+        jtj += row * row.transpose();
+        jtr += row * (area[static_cast<std::size_t>(w.idx())] - target);
+      }
+      const Vec3 off = p - centroid;
+      const double mu = options_.equalize_smoothing * 0.5 * jtj.trace();
+      jtj(0, 0) += mu;
+      jtj(1, 1) += mu;
+      jtr += mu * Eigen::Vector2d(OpenMesh::dot(off, t1), OpenMesh::dot(off, t2));
+      if (!(jtj.determinant() > 0)) return false;
+      const Eigen::Vector2d step = -jtj.inverse() * jtr * options_.lambda;
+      Vec3 d = t1 * step[0] + t2 * step[1];
+      // Never move by more than a fraction of the target length in one iteration.
+      const double cap = 0.2 * length_;
+      if (d.norm() > cap) d *= cap / d.norm();
+      goal = p + d;
+      return true;
+    };
+    move_vertices_placing([&](VertexHandle v, Vec3& out) {
+      Ring r;
+      Vec3 goal;
+      if (!newton_goal(v, goal, r)) return Placed::No;
+      if (!guard) {
+        out = relocate(v, goal, v);
+        return Placed::Moved;
+      }
+      return guarded_place(v, goal, r, out);
+    });
   }
 
   // The cosine of the smallest angle of the triangle (a, b, c); 1 when degenerate.
@@ -1420,11 +1438,11 @@ private:
   std::vector<int> displaced_; // scratch: input vertices taken off faces an operation changes
   std::vector<SurfacePoint> reprojected_;         // scratch of reproject_points()
   std::vector<Vec3> placed_;                      // scratch of move_vertices()
-  std::vector<char> moves_;                       // scratch of move_vertices()
+  std::vector<Placed> moves_;                     // scratch of move_vertices()
   std::vector<char> marked_;                      // scratch of delaunay_flips()
   std::vector<std::array<double, 3>> face_parts_; // scratch of equalize_areas_newton()
   std::vector<double> vertex_areas_;              // scratch of equalize_areas_newton()
-  std::vector<double> guard_floor_, guard_safe_;  // scratch of equalize_areas_newton()
+  std::vector<double> face_cos_;                  // scratch of equalize_areas_newton()
   void add_working_properties() {
     mesh_.add_property(loc_prop_);
     mesh_.add_property(bloc_prop_);
@@ -1436,8 +1454,8 @@ private:
   Kind& kind(VertexHandle v) { return mesh_.property(kind_prop_, v); }
   Kind kind(VertexHandle v) const { return mesh_.property(kind_prop_, v); }
   double length_ = 0, lo2_ = 0, hi_ = 0, hi2_ = 0;
-  double cos_guard_ = 1;    // cosine of equalize_guard_deg
-  std::size_t guarded_ = 0; // moves the guard halved or dropped
+  double guard_rad_ = 0, cos_guard_ = 1; // cosine of equalize_guard_deg
+  std::size_t guarded_ = 0;              // moves the guard halved or dropped
   std::size_t max_faces_ = 0;
   std::size_t live_faces_ = 0; // faces not deleted (the mesh is compacted only between phases)
 };
