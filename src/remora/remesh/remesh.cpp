@@ -1060,12 +1060,6 @@ private:
   // boundary ones), then back onto the input. One data-parallel loop computes each target from
   // the current positions and places it on the input (a relocation reads and writes only its
   // own vertex's location); the new positions are applied after it.
-  //
-  // With `guard`, a move may not open a sliver: where the placed vertex would bring a face around
-  // it below the repair angle (and below the smallest angle around it now), the move is halved,
-  // twice at most, then dropped. The test is made after the placement on the input: on a part
-  // about four edges around (smoothed fertility's arm) the projection, not the tangential step,
-  // is what squeezed an edge to 0.31 l.
   template <class Target>
   void move_vertices(Target&& target) {
     move_vertices_placing([&](VertexHandle v, Vec3& out) {
