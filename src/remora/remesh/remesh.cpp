@@ -1131,14 +1131,14 @@ private:
   // tangential step, is what squeezed an edge to 0.31 l.
   Placed guarded_place(VertexHandle v, Vec3 goal, const Ring& r, Vec3& out) {
     const Vec3 p = mesh_.point(v);
-    // The ring's smallest angle now (face_cos_, from the iteration's face loop), and how far v
+    // The ring's smallest angle now (face_data_[f][3], from the iteration's face loop), how far v
     // may move before any angle of its ring can reach the limit: moving v by δ turns each angle
     // of a face (v, a, b) by at most 2|δ| / (r − |δ|), r the shorter of |va| and |vb|.
     double worst = -1, shortest2 = std::numeric_limits<double>::max();
     for (int j = 0; j < r.k; ++j) {
       shortest2 = std::min(shortest2, (mesh_.point(r.ring[j]) - p).sqrnorm());
       if (r.face[j].is_valid())
-        worst = std::max(worst, face_cos_[static_cast<std::size_t>(r.face[j].idx())]);
+        worst = std::max(worst, face_data_[static_cast<std::size_t>(r.face[j].idx())][3]);
     }
     const double limit = std::max(worst, cos_guard_);
     const double margin = std::acos(std::clamp(worst, -1.0, 1.0)) - guard_rad_;
@@ -1272,18 +1272,19 @@ private:
     // The mixed-area parts of every face at the current positions (face_vertices order), and the
     // vertex areas they sum to.
     const std::size_t nf = mesh_.n_faces();
-    std::vector<std::array<double, 3>>& face_parts = face_parts_; // kept between iterations
+    // Per face: its three mixed-area parts and, for the guard, the cosine of its smallest angle
+    // (one cache line's worth for both readers).
+    std::vector<std::array<double, 4>>& face_parts = face_data_; // kept between iterations
     face_parts.resize(nf);
     const bool guard = options_.equalize_guard_deg > 0;
-    if (guard) face_cos_.resize(nf); // the faces' smallest-angle cosines, for the guard
 
     parallel_for(nf, options_.threads, [&](std::size_t i) {
       const FaceHandle f(static_cast<int>(i));
       if (mesh_.status(f).deleted()) return;
       const auto fv = face_vertices(mesh_, f);
       const Vec3 &a = mesh_.point(fv[0]), &b = mesh_.point(fv[1]), &c = mesh_.point(fv[2]);
-      face_parts[i] = triangle_mixed_areas(a, b, c);
-      if (guard) face_cos_[i] = smallest_angle_cos(a, b, c);
+      const auto parts = triangle_mixed_areas(a, b, c);
+      face_parts[i] = {parts[0], parts[1], parts[2], guard ? smallest_angle_cos(a, b, c) : 1.0};
     });
     std::vector<double>& area = vertex_areas_;
     area.assign(mesh_.n_vertices(), 0.0);
@@ -1430,13 +1431,12 @@ private:
   std::vector<SurfacePoint> track_;
   std::vector<int> next_, prev_;
   std::vector<int> displaced_; // scratch: input vertices taken off faces an operation changes
-  std::vector<SurfacePoint> reprojected_;         // scratch of reproject_points()
-  std::vector<Vec3> placed_;                      // scratch of move_vertices()
-  std::vector<Placed> moves_;                     // scratch of move_vertices()
-  std::vector<char> marked_;                      // scratch of delaunay_flips()
-  std::vector<std::array<double, 3>> face_parts_; // scratch of equalize_areas_newton()
-  std::vector<double> vertex_areas_;              // scratch of equalize_areas_newton()
-  std::vector<double> face_cos_;                  // scratch of equalize_areas_newton()
+  std::vector<SurfacePoint> reprojected_;        // scratch of reproject_points()
+  std::vector<Vec3> placed_;                     // scratch of move_vertices()
+  std::vector<Placed> moves_;                    // scratch of move_vertices()
+  std::vector<char> marked_;                     // scratch of delaunay_flips()
+  std::vector<std::array<double, 4>> face_data_; // scratch of equalize_areas_newton()
+  std::vector<double> vertex_areas_;             // scratch of equalize_areas_newton()
   void add_working_properties() {
     mesh_.add_property(loc_prop_);
     mesh_.add_property(bloc_prop_);
