@@ -4,13 +4,13 @@
 // quality figures of both outputs. Built only with -DREMORA_WITH_CGAL=ON: CGAL is GPL and stays out
 // of the library and the default build. Results go to docs/benchmarks.md with the machine.
 //
-//   remora_bench_remesh [--repeat N] [--large] [--json] [--threads T] [--cgal-relax-boundary]
-//                       [--write-dir DIR] [mesh files...]
+//   remora_bench_remesh [--repeat N] [--cycles N] [--large] [--json] [--threads T]
+//                       [--cgal-relax-boundary] [--write-dir DIR] [mesh files...]
 //
 // Without files: the CI meshes of ../shared/data/MANIFEST.md that load as manifolds (plus
 // derived/igea_sub4.ply with --large). l = 0.9 x the loaded mesh's length scale (its mean edge length unless needles inflate it), as remesh()
-// computes it; 5 cycles. Ours runs twice per round: default options (5 cycles + the default 7
-// equalization iterations) and cycles only (equalize_iterations = 0, the like-for-like comparison). CGAL keeps
+// computes it; Remora's default number of cycles for both (--cycles). Ours runs twice per round:
+// default options (cycles + the default 7 equalization iterations) and cycles only (equalize_iterations = 0, the like-for-like comparison). CGAL keeps
 // the mesh boundary by default: boundary edges are split at midpoints and collapsed onto boundary
 // vertices, boundary vertices are not smoothed (--cgal-relax-boundary lets them slide along
 // chords of the boundary polyline instead, which leaves the input boundary).
@@ -51,11 +51,11 @@ using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
 using SurfaceMesh = CGAL::Surface_mesh<Kernel::Point_3>;
 using Clock = std::chrono::steady_clock;
 
-constexpr int kCycles = 5;
 constexpr double kLengthFactor = 0.9;
 
 struct Args {
   int repeat = 3;
+  int cycles = remora::RemeshOptions{}.cycles; // for both contenders
   bool large = false;
   bool json = false;
   int threads = 0;
@@ -255,7 +255,7 @@ void race(MeshRace& r, const Args& args) {
 
   remora::RemeshOptions eq_options;
   eq_options.target_length = l; // what the default (length_factor 0.9) gives; explicit = same l
-  eq_options.cycles = kCycles;
+  eq_options.cycles = args.cycles;
   eq_options.threads = args.threads;
   // CGAL computes no quality figures either; both outputs are measured afterwards, untimed.
   eq_options.compute_report = false;
@@ -263,9 +263,9 @@ void race(MeshRace& r, const Args& args) {
   cycles_options.equalize_iterations = 0;
 
   const SurfaceMesh cgal_input = to_cgal(input);
-  const auto cgal_parameters =
-      CGAL::parameters::number_of_iterations(kCycles).protect_constraints(false).relax_constraints(
-          args.cgal_relax_boundary);
+  const auto cgal_parameters = CGAL::parameters::number_of_iterations(args.cycles)
+                                   .protect_constraints(false)
+                                   .relax_constraints(args.cgal_relax_boundary);
 
   std::optional<remora::Mesh> ours_eq_out, ours_cycles_out;
   std::optional<SurfaceMesh> cgal_out;
@@ -392,7 +392,7 @@ void print_variant(const Variant& v) {
              f.percent_interior_valence_6, fixed_or_na(f.boundary_deviation_over_l, 4));
 }
 
-void print_race(const MeshRace& r, int repeat) {
+void print_race(const MeshRace& r, int repeat, int cycles) {
   if (r.status == "missing") {
     fmt::print("## {}: skipped, file missing: {}\n\n", r.name, r.path);
     return;
@@ -403,7 +403,7 @@ void print_race(const MeshRace& r, int repeat) {
   }
   fmt::print("## {} ({} faces, {} boundary loops), l = {:.6g} (0.9 x length scale), {} cycles, "
              "best of {}\n\n",
-             r.name, r.input_faces, r.input_boundary_loops, r.target_length, kCycles, repeat);
+             r.name, r.input_faces, r.input_boundary_loops, r.target_length, cycles, repeat);
   fmt::print("| variant | faces out | wall ms | CPU ms | wall us/tri | CPU us/tri | min angle | "
              "mean abs(angle-60) | mixed area rel MAD | mean edge / l | % edges in [4/5,4/3]l | "
              "% val 6 | boundary dev / l |\n");
@@ -479,6 +479,9 @@ int main(int argc, char** argv) {
   app.add_option("meshes", args.files, "Mesh files (default: the CI meshes of ../shared/data)");
   app.add_option("--repeat", args.repeat, "Alternating rounds per mesh; best of N is reported")
       ->check(CLI::PositiveNumber);
+  app.add_option("--cycles", args.cycles, "Cycles for both contenders (default: Remora's)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
   app.add_flag("--large", args.large, "Also run derived/igea_sub4.ply (1.07M triangles)");
   app.add_flag("--json", args.json, "Print one JSON object instead of Markdown tables");
   app.add_option("--threads", args.threads, "Worker threads for ours (default: all)")
@@ -538,7 +541,7 @@ int main(int argc, char** argv) {
         fmt::print(stderr, "[{}] error: {}\n", r.name, e.what());
       }
     }
-    if (!args.json) print_race(r, args.repeat);
+    if (!args.json) print_race(r, args.repeat, args.cycles);
     std::fflush(stdout);
     races.push_back(std::move(r));
   }
@@ -550,7 +553,7 @@ int main(int argc, char** argv) {
                         {"load_average_start", number_or_null(load_before)},
                         {"load_average_end", number_or_null(load_average())},
                         {"threads_ours", args.threads},
-                        {"cycles", kCycles},
+                        {"cycles", args.cycles},
                         {"equalize_iterations", remora::RemeshOptions{}.equalize_iterations},
                         {"length_factor", kLengthFactor},
                         {"repeat", args.repeat},
