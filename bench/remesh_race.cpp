@@ -10,7 +10,7 @@
 // Without files: the CI meshes of ../shared/data/MANIFEST.md that load as manifolds (plus
 // derived/igea_sub4.ply with --large). l = 0.9 x the loaded mesh's length scale (its mean edge length unless needles inflate it), as remesh()
 // computes it; Remora's default number of cycles for both (--cycles). Ours runs twice per round:
-// default options (cycles + the default 7 equalization iterations) and cycles only (equalize_iterations = 0, the like-for-like comparison). CGAL keeps
+// default options (cycles + the default equalization iterations) and cycles only (equalize_iterations = 0, the like-for-like comparison). CGAL keeps
 // the mesh boundary by default: boundary edges are split at midpoints and collapsed onto boundary
 // vertices, boundary vertices are not smoothed (--cgal-relax-boundary lets them slide along
 // chords of the boundary polyline instead, which leaves the input boundary).
