@@ -68,8 +68,9 @@ private:
   // Interior vertices (all of them on a closed mesh), then boundary vertices: their row indices.
   std::vector<Eigen::Index> interior_, boundary_;
   Eigen::VectorXd mass_, boundary_mass_;
-  Eigen::SparseMatrix<double> coupling_;    // t W restricted to interior rows, boundary columns
-  std::unique_ptr<Solver> solver_;          // interior system; null when smoothing == 0
+  Eigen::SparseMatrix<double> coupling_; // t W restricted to interior rows, boundary columns
+  // The interior system; null when smoothing == 0 or when no vertex is interior.
+  std::unique_ptr<Solver> solver_;
   std::unique_ptr<Solver> boundary_solver_; // the loops' curve system; null without boundary
   bool solved_ = false;                     // false: smoothing == 0, the identity
   int steps_ = 1;

@@ -37,8 +37,8 @@ struct RemeshOptions {
   double length_factor = 0.9;
   /// Cycles of split (> 4/3 l), collapse (< 4/5 l), valence flips, tangential smoothing. The
   /// paper says about 5; the cycles are still converging there: 7 took the mean |θ−60°| down by
-  /// 0.3–0.9° on every mesh of docs/remesh.md's table (bunny 7.54° → 6.97°, conrod 7.84° →
-  /// 6.93°) and the area figures with it.
+  /// 0.2–0.9° on every mesh of docs/remesh.md's table (with 7 fine-tuning iterations: bunny
+  /// 7.54° → 6.97°, conrod 7.84° → 6.93°) and the area figures with it.
   int cycles = 7;
   /// Iterations of the area-equalizing fine-tuning (§4); 0 skips it. After 7 cycles, 6 at
   /// λ = 0.8 meet the goals that 7 at λ = 0.75 meet (docs/remesh.md).
