@@ -125,6 +125,9 @@ void add_remesh_command(CLI::App& app) {
                   "(degrees; 0 = off)")
       ->check(CLI::Range(0.0, 60.0))
       ->capture_default_str();
+  cmd->add_flag("!--no-boundary-equalization", o.equalize_boundary,
+                "newton: leave the boundary vertices' areas out of the fine-tuning (next to the "
+                "boundary, tangential smoothing only)");
   cmd->add_option("--threads", o.threads, "Worker threads (default: all)")
       ->check(CLI::NonNegativeNumber);
   cmd->add_flag("--no-project", a->no_project,

@@ -1103,6 +1103,7 @@ private:
     FaceHandle face[kMax];
     int third[kMax];
     int k = 0;
+    bool boundary_band = false; // keep the edges to the ring's boundary vertices in the band
   };
 
   // Is the cosine of the smallest angle of every face of `r`, with its centre at q, at most
@@ -1128,7 +1129,9 @@ private:
   // so that no face of its ring falls below the guard angle, nor below the ring's smallest angle
   // where that is smaller already; else v stays. Tested after the placement on the input: on a
   // part about four edges around (the smoothed fertility's arm) the projection, not the
-  // tangential step, is what squeezed an edge to 0.31 l.
+  // tangential step, is what squeezed an edge to 0.31 l. Next to the boundary the same holds for
+  // the length of each edge to a boundary vertex: at most 4/3 l, or its length now if longer
+  // (equalize_boundary pulls these vertices inwards, to grow the boundary cells).
   Placed guarded_place(VertexHandle v, Vec3 goal, const Ring& r, Vec3& out) {
     const Vec3 p = mesh_.point(v);
     // The ring's smallest angle now (face_data_[f][3], from the iteration's face loop), how far v
@@ -1143,9 +1146,27 @@ private:
     const double limit = std::max(worst, cos_guard_);
     const double margin = std::acos(std::clamp(worst, -1.0, 1.0)) - guard_rad_;
     const double safe = margin > 0 ? margin * std::sqrt(shortest2) / (2 + margin) : 0.0;
+    // Next to the boundary: every edge of the ring stays in the band [4/5 l, 4/3 l], or no
+    // further out of it than it is now.
+    double reach2 = hi2_, short2 = lo2_;
+    if (r.boundary_band)
+      for (int j = 0; j < r.k; ++j) {
+        const double d2 = (mesh_.point(r.ring[j]) - p).sqrnorm();
+        reach2 = std::max(reach2, d2);
+        short2 = std::min(short2, d2);
+      }
+    auto edges_within = [&](const Vec3& q) {
+      if (!r.boundary_band) return true;
+      for (int j = 0; j < r.k; ++j) {
+        const double d2 = (mesh_.point(r.ring[j]) - q).sqrnorm();
+        if (d2 > reach2 || d2 < short2) return false;
+      }
+      return true;
+    };
     const SurfacePoint before = loc(v);
     for (int tries = 0; tries < 3; ++tries, goal = (p + goal) * 0.5) {
       out = relocate(v, goal, v);
+      if (!edges_within(out)) continue;
       if ((out - p).sqrnorm() <= safe * safe || ring_within(r, out, limit))
         return tries == 0 ? Placed::Moved : Placed::Shortened;
     }
@@ -1321,10 +1342,12 @@ private:
         ++k;
       }
       if (k < 3) return false;
-      // Next to the boundary (which does not move here) the area term would squeeze the
-      // boundary triangles: keep to plain tangential smoothing there.
+      // Next to the boundary (which does not move here) the vertex either takes the Newton step
+      // on residuals that include the boundary vertices' (equalize_boundary; its placement then
+      // keeps the edges to them in the band), or plain tangential smoothing.
       bool near_boundary = false;
       for (int j = 0; j < k; ++j) near_boundary |= kind(ring[j]) != Kind::Interior;
+      r.boundary_band = near_boundary && options_.equalize_boundary;
       // The circulator turns one way: the third corner of face j is ring[j + 1] or ring[j - 1].
       const HalfedgeHandle h0 = *mesh_.cvoh_begin(v);
       const VertexHandle c0 = mesh_.to_vertex_handle(mesh_.next_halfedge_handle(h0));
@@ -1340,7 +1363,7 @@ private:
       const double normal_length = normal.norm();
       if (!(normal_length > 0)) return false;
       const Vec3 n = normal / normal_length;
-      if (near_boundary) {
+      if (near_boundary && !options_.equalize_boundary) {
         Vec3 u = centroid - p;
         u -= n * OpenMesh::dot(n, u);
         goal = p + u * options_.lambda;
@@ -1375,12 +1398,14 @@ private:
         parts(p + t * eps, moved);
         for (int j = 0; j <= k; ++j) d[j] = (moved[j] - base[j]) / eps;
       }
-      // Residuals: the ring's interior vertices and v itself (index k).
+      // Residuals: v itself (index k) and the ring's interior vertices, with equalize_boundary
+      // its boundary vertices too (not the corners, whose cells are smaller still).
       Eigen::Matrix2d jtj = Eigen::Matrix2d::Zero();
       Eigen::Vector2d jtr = Eigen::Vector2d::Zero();
       for (int j = 0; j <= k; ++j) {
         const VertexHandle w = j == k ? v : ring[j];
-        if (kind(w) != Kind::Interior) continue;
+        const Kind kw = kind(w);
+        if (kw == Kind::Corner || (kw == Kind::Boundary && !options_.equalize_boundary)) continue;
         const Eigen::Vector2d row(d1[j], d2[j]);
         jtj += row * row.transpose();
         jtr += row * (area[static_cast<std::size_t>(w.idx())] - target);
@@ -1403,7 +1428,7 @@ private:
       Ring r;
       Vec3 goal;
       if (!newton_goal(v, goal, r)) return Placed::No;
-      if (!guard) {
+      if (!guard && !r.boundary_band) {
         out = relocate(v, goal, v);
         return Placed::Moved;
       }
