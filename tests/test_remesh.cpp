@@ -3,6 +3,7 @@
 // correspondence in both directions, determinism.
 #include <cmath>
 #include <filesystem>
+#include <numeric>
 #include <random>
 #include <string>
 
@@ -307,6 +308,38 @@ TEST(Remesh, TracksInputVerticesThroughEveryOperation) {
     EXPECT_LT(rep.tracked_excess_mean, 1e-4) << "shape " << shape;
     EXPECT_LT(rep.tracked_excess_max, 0.05) << "shape " << shape;
   }
+}
+
+// A large input is remeshed in a spatial order of its own; the correspondence must come back
+// in the caller's numbering. The grid's vertices and faces are shuffled (no spatial order left)
+// and it is flat, so every input vertex lies exactly on the output.
+TEST(Remesh, LargeShuffledInputGetsItsCorrespondenceInItsOwnNumbering) {
+  const Mesh grid = make_grid(130, 130, 1.0, 1.0); // 33,800 faces: above the spatial threshold
+  std::mt19937 rng(7);
+  std::vector<int> vorder(grid.n_vertices());
+  std::iota(vorder.begin(), vorder.end(), 0);
+  std::shuffle(vorder.begin(), vorder.end(), rng);
+  std::vector<int> where(vorder.size());
+  Mesh input;
+  for (std::size_t i = 0; i < vorder.size(); ++i) {
+    where[static_cast<std::size_t>(vorder[i])] = static_cast<int>(i);
+    input.add_vertex(grid.point(VertexHandle(vorder[i])));
+  }
+  std::vector<FaceHandle> faces(grid.faces().begin(), grid.faces().end());
+  std::shuffle(faces.begin(), faces.end(), rng);
+  for (FaceHandle f : faces) {
+    const auto fv = face_vertices(grid, f);
+    input.add_face(VertexHandle(where[fv[0].idx()]), VertexHandle(where[fv[1].idx()]),
+                   VertexHandle(where[fv[2].idx()]));
+  }
+  ASSERT_GT(input.n_faces(), 32768u);
+  RemeshOptions opt;
+  opt.target_length = 0.02;
+  const RemeshResult r = remesh(input, opt);
+  expect_sound_output(r, input);
+  for (auto v : input.vertices())
+    ASSERT_LT((evaluate(r.mesh, r.input_on_output[v.idx()]) - input.point(v)).norm(), 1e-9)
+        << "input vertex " << v.idx();
 }
 
 TEST(Remesh, IsDeterministicWhateverTheThreadCount) {
