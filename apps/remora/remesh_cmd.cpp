@@ -128,6 +128,11 @@ void add_remesh_command(CLI::App& app) {
   cmd->add_flag("!--no-boundary-equalization", o.equalize_boundary,
                 "newton: leave the boundary vertices' areas out of the fine-tuning (next to the "
                 "boundary, tangential smoothing only)");
+  cmd->add_option("--boundary-spacing", o.boundary_spacing,
+                  "Spacing of the boundary vertices in l, set after the first cycle (<= 1: as the "
+                  "cycles leave it)")
+      ->check(CLI::Range(0.0, 4.0 / 3.0))
+      ->capture_default_str();
   cmd->add_option("--threads", o.threads, "Worker threads (default: all)")
       ->check(CLI::NonNegativeNumber);
   cmd->add_flag("--no-project", a->no_project,

@@ -215,6 +215,8 @@ public:
     init_points();
     for (int cycle = 0; cycle < options_.cycles; ++cycle) {
       progress("remesh", cycle, options_.cycles);
+      if (cycle == 1 && options_.boundary_spacing > 1)
+        timed("collapse", [&] { report.collapses += resample_boundary(); });
       timed("split", [&] { report.splits += split_long_edges(); });
       timed("collapse", [&] { report.collapses += collapse_short_edges(); });
       timed("flip", [&] { report.flips += equalize_valences(); });
@@ -308,7 +310,9 @@ private:
   void mark_corners() {
     const double corner_cos = std::cos(options_.corner_angle_deg * M_PI / 180.0);
     const double reach2 = 0.25 * length_ * length_;
-    for (const auto& loop : boundary_loops(input_)) {
+    const auto loops = boundary_loops(input_);
+    has_boundary_ = !loops.empty();
+    for (const auto& loop : loops) {
       const std::size_t n = loop.size();
       if (n < 3) continue;
       std::vector<VertexHandle> vs(n);
@@ -851,7 +855,7 @@ private:
     return count;
   }
 
-  enum class Collapse { Short, Repair };
+  enum class Collapse { Short, Repair, Boundary };
 
   // Collapses e if the rules allow it: corners never go, an interior vertex goes onto a boundary
   // vertex (which stays put), two boundary vertices merge along a boundary edge only, and the
@@ -878,7 +882,9 @@ private:
     // Laplacian less than a sliver), and must raise the smallest angle around it. The length
     // test comes first: it is the cheapest and the one that fails most (two thirds of the short
     // edges of a cycle cannot go without leaving an edge longer than 4/3 l).
-    const double reach2 = purpose == Collapse::Short ? hi2_ : 1.4 * hi2_;
+    const double reach2 = purpose == Collapse::Short    ? hi2_
+                          : purpose == Collapse::Repair ? 1.4 * hi2_
+                                                        : 4 * hi2_;
     bool ok = neighbours_within(a, b, target, reach2);
     if (ok && !collapse_keeps_manifold(h)) {
       if (!midpoint) return false;
@@ -1210,6 +1216,90 @@ private:
     return true;
   }
 
+  // The working mesh's boundary loops cut at their corners into runs u_0 ... u_m (u_0 and u_m
+  // corners; a loop without corners is one run with u_m = u_0).
+  std::vector<std::vector<VertexHandle>> boundary_runs() const {
+    std::vector<std::vector<VertexHandle>> runs;
+    std::vector<char> seen(mesh_.n_halfedges(), 0);
+    for (auto h0 : mesh_.halfedges()) {
+      if (!mesh_.is_boundary(h0) || seen[static_cast<std::size_t>(h0.idx())]) continue;
+      std::vector<VertexHandle> loop;
+      HalfedgeHandle h = h0;
+      do {
+        seen[static_cast<std::size_t>(h.idx())] = 1;
+        loop.push_back(mesh_.from_vertex_handle(h));
+        h = mesh_.next_halfedge_handle(h);
+      } while (h != h0 && loop.size() <= mesh_.n_vertices());
+      const auto corner = std::find_if(loop.begin(), loop.end(),
+                                       [&](VertexHandle v) { return kind(v) == Kind::Corner; });
+      if (corner != loop.end()) std::rotate(loop.begin(), corner, loop.end());
+      loop.push_back(loop.front());
+      std::vector<VertexHandle> run{loop.front()};
+      for (std::size_t i = 1; i < loop.size(); ++i) {
+        run.push_back(loop[i]);
+        if (kind(loop[i]) == Kind::Corner || i + 1 == loop.size()) {
+          runs.push_back(run);
+          run = {loop[i]};
+        }
+      }
+    }
+    return runs;
+  }
+
+  // boundary_spacing: collapses evenly chosen vertices of each run whose spacing is below
+  // boundary_spacing × l, then spaces the run's vertices evenly along it (by chord length, then
+  // placed on the input boundary). Returns the number of collapses.
+  std::size_t resample_boundary() {
+    if (!has_boundary_) return 0;
+    const double spacing = options_.boundary_spacing * length_;
+    std::size_t collapsed = 0;
+    for (const auto& run : boundary_runs()) {
+      const std::size_t m = run.size() - 1;
+      double length = 0;
+      for (std::size_t i = 0; i < m; ++i)
+        length += (mesh_.point(run[i + 1]) - mesh_.point(run[i])).norm();
+      const auto wanted = static_cast<std::size_t>(std::max(1.0, std::ceil(length / spacing)));
+      if (wanted >= m || m < 3) continue;
+      const std::size_t remove = std::min(m - wanted, m - 2);
+      for (std::size_t j = 0; j < remove; ++j) {
+        const std::size_t i =
+            1 + static_cast<std::size_t>((static_cast<double>(j) + 0.5) *
+                                         static_cast<double>(m - 1) / static_cast<double>(remove));
+        const VertexHandle v = run[std::min(i, m - 1)];
+        if (mesh_.status(v).deleted() || kind(v) != Kind::Boundary) continue;
+        const HalfedgeHandle out = boundary_out(mesh_, v);
+        if (!out.is_valid()) continue;
+        collapsed += try_collapse(mesh_.edge_handle(out), Collapse::Boundary) ? 1 : 0;
+      }
+    }
+    // Even spacing along each run, by arc length of its chords.
+    std::vector<Vec3> goal(mesh_.n_vertices());
+    std::vector<char> has(mesh_.n_vertices(), 0);
+    for (const auto& run : boundary_runs()) {
+      const std::size_t m = run.size() - 1;
+      if (m < 2) continue;
+      std::vector<double> at(m + 1, 0.0);
+      for (std::size_t i = 0; i < m; ++i)
+        at[i + 1] = at[i] + (mesh_.point(run[i + 1]) - mesh_.point(run[i])).norm();
+      std::size_t k = 0;
+      for (std::size_t i = 1; i < m; ++i) {
+        const double s = at[m] * static_cast<double>(i) / static_cast<double>(m);
+        while (k + 1 < m && at[k + 1] < s) ++k;
+        const double span = at[k + 1] - at[k];
+        const double t = span > 0 ? (s - at[k]) / span : 0.0;
+        goal[static_cast<std::size_t>(run[i].idx())] =
+            mesh_.point(run[k]) * (1 - t) + mesh_.point(run[k + 1]) * t;
+        has[static_cast<std::size_t>(run[i].idx())] = kind(run[i]) == Kind::Boundary;
+      }
+    }
+    move_vertices([&](VertexHandle v, Vec3& g) {
+      if (!has[static_cast<std::size_t>(v.idx())]) return false;
+      g = goal[static_cast<std::size_t>(v.idx())];
+      return true;
+    });
+    return collapsed;
+  }
+
   void tangential_smoothing() {
     move_vertices([&](VertexHandle v, Vec3& goal) {
       if (kind(v) == Kind::Boundary) return boundary_target(v, 0.5, goal);
@@ -1500,6 +1590,7 @@ private:
   double guard_rad_ = 0, cos_guard_ = 1; // cosine of equalize_guard_deg
   std::size_t guarded_ = 0;              // moves the guard halved or dropped
   std::size_t max_faces_ = 0;
+  bool has_boundary_ = false;  // the input has a boundary (mark_corners)
   std::size_t live_faces_ = 0; // faces not deleted (the mesh is compacted only between phases)
 };
 
