@@ -490,6 +490,11 @@ TEST(Remesh, RejectsBadOptions) {
   EXPECT_THROW(remesh(input, opt), InvalidArgument);
   opt.equalize_guard_deg = std::nan("");
   EXPECT_THROW(remesh(input, opt), InvalidArgument);
+  opt.equalize_guard_deg = 30;
+  opt.boundary_spacing = 1.5;
+  EXPECT_THROW(remesh(input, opt), InvalidArgument);
+  opt.boundary_spacing = std::nan("");
+  EXPECT_THROW(remesh(input, opt), InvalidArgument);
   EXPECT_THROW(remesh(Mesh()), InvalidArgument);
 }
 

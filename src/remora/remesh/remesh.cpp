@@ -431,8 +431,7 @@ private:
   void compact() { renumber(live_faces_ > kSpatialOrderFaces); }
 
   // Compacts the mesh (copy_in_order) and carries the working properties and point lists along.
-  // On igea_sub4 (1.07M faces) a spatially sorted input remeshed 30 % faster than the file's
-  // order; after the cycles, with many deleted elements, the copy is faster than OpenMesh's
+  // After the cycles, with many deleted elements, the copy is faster than OpenMesh's
   // garbage_collection (camelhead: 8 ms against 11); the repair, which deletes a few, keeps the
   // garbage collection.
   void renumber(bool spatially) {
@@ -1608,10 +1607,13 @@ RemeshResult remesh(const Mesh& input, const RemeshOptions& options) {
     throw InvalidArgument("remesh: lambda must be in (0, 1]");
   if (!(options.equalize_guard_deg >= 0 && options.equalize_guard_deg < 60))
     throw InvalidArgument("remesh: equalize_guard_deg must be in [0, 60) degrees (0 = off)");
+  if (!(options.boundary_spacing <= 4.0 / 3.0))
+    throw InvalidArgument("remesh: boundary_spacing must be at most 4/3 (longer boundary edges "
+                          "are split again; <= 1 turns the spacing off)");
   // A large input is remeshed in a spatial order (copy_in_order), its walks and the first cycle
   // then read memory close to what they read before; the correspondence goes back to the
-  // caller's numbering at the end. igea_sub4 (1.07M faces, Loop-subdivided): 9.0-9.4 s -> 8.0 s
-  // on a copy sorted beforehand.
+  // caller's numbering at the end. igea_sub4 (1.07M faces, Loop-subdivided): median 9.4 s ->
+  // 8.6 s (docs/benchmarks.md, session 8).
   const bool compact =
       input.n_vertices() ==
       static_cast<std::size_t>(std::distance(input.vertices().begin(), input.vertices().end()));

@@ -75,8 +75,9 @@ struct RemeshOptions {
   /// Spacing of the boundary vertices, in l, set once after the first cycle: where a run of the
   /// boundary between corners has closer vertices, every so many are collapsed and the rest
   /// spaced evenly along it. Longer boundary edges give the boundary vertices larger cells
-  /// (their Voronoi cell ends at the boundary; docs/remesh.md, "Boundary spacing"). Values ≤ 1,
-  /// or fewer than 2 cycles, leave the boundary as the cycles make it.
+  /// (their Voronoi cell ends at the boundary; docs/remesh.md, "Boundary spacing"). At most
+  /// 4/3 (longer boundary edges are split again); values ≤ 1, or fewer than 2 cycles, leave the
+  /// boundary as the cycles make it.
   double boundary_spacing = 1.2;
   /// Fill the quality part of RemeshReport (figures, symmetry defects, distances to the input).
   /// Off, only counts and timings are reported: 10-16 % faster, for callers that need no figures.
@@ -131,7 +132,8 @@ struct RemeshResult {
 };
 
 /// Remeshes `input` (a repaired, manifold triangle mesh). Throws InvalidArgument for an empty
-/// mesh, a non-finite or non-positive target length, or negative counts.
+/// mesh, a non-finite or non-positive target length, negative counts, or an option outside its
+/// range (lambda, equalize_guard_deg, boundary_spacing).
 RemeshResult remesh(const Mesh& input, const RemeshOptions& options = {});
 
 nlohmann::json to_json(const RemeshReport& report);
