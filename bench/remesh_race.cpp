@@ -32,6 +32,7 @@
 #include <vector>
 
 #include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Polygon_mesh_processing/detect_features.h>
 #include <CGAL/Polygon_mesh_processing/remesh.h>
 #include <CGAL/Surface_mesh.h>
 #include <CGAL/version.h>
@@ -60,6 +61,7 @@ struct Args {
   bool json = false;
   int threads = 0;
   bool cgal_relax_boundary = false;
+  double feature_angle = 0; // both keep the input's feature lines (0: none)
   bool fresh_memory = false;
   std::string write_dir;
   std::vector<std::string> files;
@@ -257,15 +259,28 @@ void race(MeshRace& r, const Args& args) {
   eq_options.target_length = l; // what the default (length_factor 0.9) gives; explicit = same l
   eq_options.cycles = args.cycles;
   eq_options.threads = args.threads;
+  eq_options.feature_angle_deg = args.feature_angle;
   // CGAL computes no quality figures either; both outputs are measured afterwards, untimed.
   eq_options.compute_report = false;
   remora::RemeshOptions cycles_options = eq_options;
   cycles_options.equalize_iterations = 0;
 
   const SurfaceMesh cgal_input = to_cgal(input);
-  const auto cgal_parameters = CGAL::parameters::number_of_iterations(args.cycles)
-                                   .protect_constraints(false)
-                                   .relax_constraints(args.cgal_relax_boundary);
+  // With --feature-angle, CGAL's own detection (the same dihedral test) marks the lines it
+  // keeps; its constrained edges may still be split and collapsed along them.
+  SurfaceMesh cgal_marked = cgal_input;
+  auto constrained =
+      cgal_marked.add_property_map<SurfaceMesh::Edge_index, bool>("e:constrained", false).first;
+  if (args.feature_angle > 0)
+    CGAL::Polygon_mesh_processing::detect_sharp_edges(cgal_marked, args.feature_angle, constrained);
+  // The map of the mesh being remeshed (the copy carries the property along).
+  auto cgal_parameters = [&](SurfaceMesh& sm) {
+    return CGAL::parameters::number_of_iterations(args.cycles)
+        .protect_constraints(false)
+        .relax_constraints(args.cgal_relax_boundary)
+        .edge_is_constrained_map(
+            sm.property_map<SurfaceMesh::Edge_index, bool>("e:constrained").first);
+  };
 
   std::optional<remora::Mesh> ours_eq_out, ours_cycles_out;
   std::optional<SurfaceMesh> cgal_out;
@@ -282,9 +297,9 @@ void race(MeshRace& r, const Args& args) {
   for (int round = 0; round < args.repeat; ++round) {
     const Timing a = run_ours(r.ours_eq, eq_options, ours_eq_out);
 
-    SurfaceMesh sm = cgal_input; // the copy is not timed
+    SurfaceMesh sm = cgal_marked; // the copy is not timed
     const Timing b = timed([&] {
-      CGAL::Polygon_mesh_processing::isotropic_remeshing(faces(sm), l, sm, cgal_parameters);
+      CGAL::Polygon_mesh_processing::isotropic_remeshing(faces(sm), l, sm, cgal_parameters(sm));
     });
     r.cgal.runs.push_back(b);
     cgal_out = std::move(sm);
@@ -488,6 +503,10 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   app.add_flag("--cgal-relax-boundary", args.cgal_relax_boundary,
                "CGAL relax_constraints(true): boundary vertices slide along boundary chords");
+  app.add_option("--feature-angle", args.feature_angle,
+                 "Both keep the input's feature lines: edges whose faces' normals differ by more "
+                 "than this many degrees (CGAL: detect_sharp_edges)")
+      ->check(CLI::Range(0.0, 179.0));
   app.add_option("--write-dir", args.write_dir, "Write both outputs of every mesh as PLY here");
   app.add_flag("--fresh-memory", args.fresh_memory,
                "Leave glibc's defaults (the remora CLI keeps freed memory for reuse, so does this "

@@ -158,6 +158,16 @@ TEST_F(Cli, RemeshWritesTheMeshAndAReportThatAgreesWithIt) {
   const CliRun table = run("remesh " + in.string() + " -o " + out.string() + " --report");
   ASSERT_EQ(table.exit_code, 0) << table.err;
   EXPECT_NE(table.out.find("Laplacian symmetry defect"), std::string::npos) << table.out;
+  // --feature-angle keeps the cube's edges: 4 mesh edges each at n = 4.
+  const fs::path cube = dir_ / "cube.off";
+  write_mesh(cube.string(), make_cube(4, 1.0));
+  const CliRun features = run("remesh " + cube.string() + " -o " + out.string() +
+                              " --length 0.2 --feature-angle 45 --json");
+  ASSERT_EQ(features.exit_code, 0) << features.err;
+  EXPECT_EQ(nlohmann::json::parse(features.out)["feature_edges"], 48);
+  EXPECT_LT(nlohmann::json::parse(features.out)["distance_to_input"]["centroid_max"], 1e-12);
+  EXPECT_EQ(
+      run("remesh " + cube.string() + " -o " + out.string() + " --feature-angle 180").exit_code, 2);
 }
 
 // --low-pass remeshes the editor's base surface: on a sphere with radial noise, the output's

@@ -691,5 +691,85 @@ TEST(LocateBoundary, RejectsUnusableHalfedges) {
   EXPECT_THROW(walk_to_closest_on_boundary(mesh, q, boundary, -2), InvalidArgument);
 }
 
+// The curve walk with the boundary as its curve is the boundary walk.
+TEST(LocateCurve, OnTheBoundaryItIsTheBoundaryWalk) {
+  const Mesh mesh = make_annulus(3, 40, 0.5, 1.5);
+  std::vector<char> boundary(mesh.n_edges(), 0);
+  for (auto e : mesh.edges()) boundary[static_cast<std::size_t>(e.idx())] = mesh.is_boundary(e);
+  std::mt19937 rng(73);
+  for (const double radius : {0.5, 1.5}) {
+    const auto loop = loop_at_radius(mesh, radius);
+    for (int k = 0; k < 200; ++k) {
+      const double angle = 2.0 * std::numbers::pi * unit(rng);
+      const double r = radius * (1.0 + 0.4 * symmetric_unit(rng));
+      const Vec3 q(r * std::cos(angle), r * std::sin(angle), 0.2 * symmetric_unit(rng));
+      const HalfedgeHandle start = loop[rng() % loop.size()];
+      const BoundaryPoint expected = walk_to_closest_on_boundary(mesh, q, start);
+      const BoundaryPoint found = walk_to_closest_on_curve(mesh, q, start, boundary);
+      EXPECT_EQ(found.halfedge, expected.halfedge);
+      EXPECT_EQ(found.point.face, expected.point.face);
+      EXPECT_EQ(found.point.bary, expected.point.bary);
+    }
+  }
+}
+
+// On the cube's feature lines: the walk follows the line it starts on and stops where three
+// lines meet (a corner), whatever the query.
+TEST(LocateCurve, FollowsAFeatureLineAndStopsAtItsCorners) {
+  const Mesh cube = make_cube(6, 1.0);
+  const std::vector<char> lines = feature_edges(cube, 45.0);
+  // The line x = y = 1/2, along z, and one of its halfedges to start from.
+  auto on_line = [&](VertexHandle v) {
+    const Vec3 p = cube.point(v);
+    return p[0] == 0.5 && p[1] == 0.5;
+  };
+  std::vector<HalfedgeHandle> starts;
+  for (auto h : cube.halfedges())
+    if (lines[static_cast<std::size_t>(h.idx() / 2)] && on_line(cube.from_vertex_handle(h)) &&
+        on_line(cube.to_vertex_handle(h)))
+      starts.push_back(h);
+  ASSERT_EQ(starts.size(), 12u); // 6 edges, both halfedges
+  std::mt19937 rng(79);
+  for (int k = 0; k < 300; ++k) {
+    const double z = 0.8 * symmetric_unit(rng); // past the corners at +-1/2 too
+    const Vec3 q(0.5 + 0.3 * symmetric_unit(rng), 0.5 + 0.3 * symmetric_unit(rng), z);
+    const HalfedgeHandle start = starts[rng() % starts.size()];
+    const BoundaryPoint bp = walk_to_closest_on_curve(cube, q, start, lines);
+    ASSERT_TRUE(on_line(cube.from_vertex_handle(bp.halfedge)) &&
+                on_line(cube.to_vertex_handle(bp.halfedge)));
+    EXPECT_EQ(bp.point.face, cube.face_handle(bp.halfedge));
+    const Vec3 found = evaluate(cube, bp.point);
+    EXPECT_LE((found - Vec3(0.5, 0.5, std::clamp(z, -0.5, 0.5))).norm(), 1e-12) << "query " << k;
+  }
+  // A boundary halfedge of the curve puts its point on the face across it.
+  const Mesh disc = make_disc(2, 6, 1.0);
+  std::vector<char> rim(disc.n_edges(), 0);
+  HalfedgeHandle boundary;
+  for (auto h : disc.halfedges())
+    if (disc.is_boundary(h)) {
+      rim[static_cast<std::size_t>(h.idx() / 2)] = 1;
+      boundary = h;
+    }
+  const BoundaryPoint bp = walk_to_closest_on_curve(disc, Vec3(2, 0, 0), boundary, rim);
+  EXPECT_TRUE(disc.is_boundary(bp.halfedge));
+  EXPECT_EQ(bp.point.face, disc.face_handle(disc.opposite_halfedge_handle(bp.halfedge)));
+}
+
+TEST(LocateCurve, RejectsUnusableArguments) {
+  const Mesh cube = make_cube(2, 1.0);
+  const std::vector<char> lines = feature_edges(cube, 45.0);
+  HalfedgeHandle marked, unmarked;
+  for (auto h : cube.halfedges())
+    (lines[static_cast<std::size_t>(h.idx() / 2)] ? marked : unmarked) = h;
+  const Vec3 q(1, 1, 1);
+  EXPECT_NO_THROW(walk_to_closest_on_curve(cube, q, marked, lines));
+  EXPECT_THROW(walk_to_closest_on_curve(cube, q, unmarked, lines), InvalidArgument);
+  EXPECT_THROW(walk_to_closest_on_curve(cube, q, HalfedgeHandle(), lines), InvalidArgument);
+  EXPECT_THROW(walk_to_closest_on_curve(cube, q, marked, std::vector<char>(3, 1)), InvalidArgument);
+  EXPECT_THROW(walk_to_closest_on_curve(cube, Vec3(0, std::nan(""), 0), marked, lines),
+               InvalidArgument);
+  EXPECT_THROW(walk_to_closest_on_curve(cube, q, marked, lines, -1), InvalidArgument);
+}
+
 } // namespace
 } // namespace remora

@@ -17,6 +17,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "remora/common/error.h"
 #include "remora/geometry/measures.h"
 #include "remora/geometry/quality.h"
 #include "remora/mesh/io.h"
@@ -130,6 +131,56 @@ TEST(MeasuresEdges, LengthScaleIgnoresNeedles) {
   EXPECT_NEAR(scale.from_area, 0.3 / std::sqrt(8.0), 0.15 * 0.3 / std::sqrt(8.0));
   EXPECT_EQ(scale.length, scale.from_area);
   EXPECT_EQ(length_scale(Mesh()).length, 0.0);
+}
+
+std::size_t count(const std::vector<char>& marks) {
+  std::size_t n = 0;
+  for (char c : marks) n += c != 0;
+  return n;
+}
+
+TEST(MeasuresFeatures, TheCubesEdgesAreItsOnlyFeatures) {
+  // Each of the 12 edges of the cube is 4 mesh edges whose faces meet at 90 degrees; every other
+  // edge lies in a side (its normals differ by 0).
+  const Mesh cube = make_cube(4, 1.0);
+  for (double angle : {1.0, 45.0, 89.0}) {
+    const std::vector<char> sharp = feature_edges(cube, angle);
+    ASSERT_EQ(sharp.size(), cube.n_edges());
+    EXPECT_EQ(count(sharp), 48u) << angle;
+    for (auto e : cube.edges()) {
+      if (!sharp[static_cast<std::size_t>(e.idx())]) continue;
+      // Both ends on the same edge of the cube: two coordinates at +-1/2 shared.
+      const HalfedgeHandle h = cube.halfedge_handle(e, 0);
+      const Vec3 a = cube.point(cube.from_vertex_handle(h)),
+                 b = cube.point(cube.to_vertex_handle(h));
+      int shared = 0;
+      for (int d = 0; d < 3; ++d) shared += std::abs(std::abs(a[d]) - 0.5) < 1e-12 && a[d] == b[d];
+      EXPECT_EQ(shared, 2);
+    }
+  }
+  EXPECT_EQ(count(feature_edges(cube, 91.0)), 0u);
+  EXPECT_EQ(count(feature_edges(cube, 0.0)), 48u); // the sides are exactly flat
+}
+
+TEST(MeasuresFeatures, SmoothSurfacesZeroAreaFacesAndBoundariesHaveNone) {
+  // Neighbouring faces of a 3-times subdivided icosphere differ by a few degrees.
+  const Mesh sphere = make_icosphere(3);
+  EXPECT_EQ(count(feature_edges(sphere, 20.0)), 0u);
+  EXPECT_EQ(count(feature_edges(sphere, 0.0)), sphere.n_edges());
+  // Two triangles folded at 90 degrees along their shared edge: that edge only (the four others
+  // are boundary edges). Flattening one into a line (zero area) leaves no normal: no feature.
+  Mesh fold;
+  const VertexHandle a = fold.add_vertex(Vec3(0, 0, 0)), b = fold.add_vertex(Vec3(1, 0, 0));
+  const VertexHandle c = fold.add_vertex(Vec3(0.5, 1, 0)), d = fold.add_vertex(Vec3(0.5, 0, 1));
+  fold.add_face(a, b, c);
+  fold.add_face(b, a, d);
+  EXPECT_EQ(count(feature_edges(fold, 45.0)), 1u);
+  EXPECT_EQ(count(feature_edges(fold, 91.0)), 0u);
+  fold.set_point(d, Vec3(0.5, 0, 0));
+  EXPECT_EQ(count(feature_edges(fold, 0.0)), 0u);
+  EXPECT_THROW(feature_edges(fold, -1.0), InvalidArgument);
+  EXPECT_THROW(feature_edges(fold, 180.0), InvalidArgument);
+  EXPECT_THROW(feature_edges(fold, std::nan("")), InvalidArgument);
 }
 
 TEST(MeasuresTriangle, AreaOfHandComputedTriangles) {

@@ -474,6 +474,87 @@ TEST(Remesh, FineTuningFlipsLeaveADelaunayMesh) {
   EXPECT_EQ(unflipped.report.delaunay_flips, 0u);
 }
 
+// With feature lines on, a cube keeps its 12 edges and 8 corners exactly: every output triangle
+// lies in a side, so the chord error is zero (without, the output cuts the edges off), and the
+// output edges on the cube's edges cover them.
+TEST(Remesh, KeepsTheCubesFeatureLinesAndCorners) {
+  const Mesh cube = make_cube(12, 1.0);
+  RemeshOptions options;
+  options.feature_angle_deg = 45;
+  const RemeshResult r = remesh(cube, options);
+  expect_sound_output(r, cube);
+  const Mesh& m = r.mesh;
+  EXPECT_EQ(r.report.feature_edges, 144u);
+  auto at_half = [](double x) { return std::abs(std::abs(x) - 0.5) < 1e-12; };
+  auto halves = [&](const Vec3& p) { return at_half(p[0]) + at_half(p[1]) + at_half(p[2]); };
+  int corners = 0;
+  for (auto v : m.vertices()) corners += halves(m.point(v)) == 3;
+  EXPECT_EQ(corners, 8);
+  double along_edges = 0;
+  for (auto e : m.edges()) {
+    const HalfedgeHandle h = m.halfedge_handle(e, 0);
+    const Vec3 a = m.point(m.from_vertex_handle(h)), b = m.point(m.to_vertex_handle(h));
+    int shared = 0;
+    for (int d = 0; d < 3; ++d) shared += at_half(a[d]) && std::abs(a[d] - b[d]) < 1e-12;
+    if (shared == 2) along_edges += (a - b).norm();
+  }
+  EXPECT_NEAR(along_edges, 12.0, 1e-9);
+  for (auto f : m.faces()) {
+    const auto fv = face_vertices(m, f);
+    const Vec3 c = (m.point(fv[0]) + m.point(fv[1]) + m.point(fv[2])) / 3.0;
+    ASSERT_GE(halves(c), 1) << "face " << f.idx() << " cuts through the cube";
+  }
+  EXPECT_LT(r.report.centroid_distance_max, 1e-12);
+  EXPECT_GE(r.report.after_equalization.angles.min_deg, 25.0);
+  EXPECT_GT(fraction_in_band(m, r.report.target_length), 0.95);
+  // Without feature lines the remesh rounds the cube's edges off.
+  const RemeshResult plain = remesh(cube);
+  EXPECT_EQ(plain.report.feature_edges, 0u);
+  EXPECT_GT(plain.report.centroid_distance_max, 1e-3);
+  // Deterministic whatever the thread count, with feature lines too.
+  options.threads = 1;
+  const RemeshResult serial = remesh(cube, options);
+  ASSERT_EQ(serial.mesh.n_vertices(), m.n_vertices());
+  for (auto v : m.vertices()) EXPECT_EQ(serial.mesh.point(v), m.point(v));
+}
+
+// Feature lines shorter than the target length are dropped: with l above the cube's side no
+// line is kept; the boundary is never dropped.
+TEST(Remesh, FeatureLinesShorterThanTheTargetLengthAreDropped) {
+  RemeshOptions options;
+  options.feature_angle_deg = 45;
+  options.target_length = 1.2;
+  options.cycles = 1;
+  options.equalize_iterations = 0;
+  EXPECT_EQ(remesh(make_cube(4, 1.0), options).report.feature_edges, 0u);
+  options.target_length = 0.3;
+  EXPECT_EQ(remesh(make_cube(4, 1.0), options).report.feature_edges, 48u);
+  // An open box (the cube without its top side): its four vertical lines meet the boundary
+  // loop, which stays; its corners stay too.
+  Mesh box = make_cube(6, 1.0);
+  for (auto f : box.faces()) {
+    const auto fv = face_vertices(box, f);
+    bool top = true;
+    for (auto v : fv) top = top && box.point(v)[2] == 0.5;
+    if (top) box.delete_face(f, true);
+  }
+  box.garbage_collection();
+  options.target_length = 0.15;
+  options.cycles = 7;
+  options.equalize_iterations = 6;
+  const RemeshResult r = remesh(box, options);
+  expect_sound_output(r, box);
+  EXPECT_EQ(r.report.feature_edges, 8u * 6u);
+  int corners = 0;
+  for (auto v : r.mesh.vertices()) {
+    const Vec3 p = r.mesh.point(v);
+    corners += std::abs(std::abs(p[0]) - 0.5) < 1e-12 && std::abs(std::abs(p[1]) - 0.5) < 1e-12 &&
+               std::abs(std::abs(p[2]) - 0.5) < 1e-12;
+  }
+  EXPECT_EQ(corners, 8);
+  EXPECT_LT(r.report.centroid_distance_max, 1e-12);
+}
+
 TEST(Remesh, RejectsBadOptions) {
   const Mesh input = make_icosphere(1);
   RemeshOptions opt;
@@ -495,6 +576,11 @@ TEST(Remesh, RejectsBadOptions) {
   EXPECT_THROW(remesh(input, opt), InvalidArgument);
   opt.boundary_spacing = std::nan("");
   EXPECT_THROW(remesh(input, opt), InvalidArgument);
+  opt.boundary_spacing = 1.2;
+  for (double angle : {-1.0, 180.0, std::nan("")}) {
+    opt.feature_angle_deg = angle;
+    EXPECT_THROW(remesh(input, opt), InvalidArgument) << angle;
+  }
   EXPECT_THROW(remesh(Mesh()), InvalidArgument);
 }
 

@@ -68,6 +68,9 @@ void print_remesh_report(std::ostream& os, const RemeshReport& r) {
   os << fmt::format("input -> output locations, tracked through every operation: farther than "
                     "the closest point by {:.1e} l on average, {:.1e} l at most\n",
                     r.tracked_excess_mean, r.tracked_excess_max);
+  if (r.feature_edges > 0)
+    os << fmt::format("feature lines kept: {} input edges sharper than the feature angle\n",
+                      grouped(r.feature_edges));
   os << fmt::format("operations: {} splits, {} collapses, {} flips, {} repairs; {} Delaunay flips "
                     "in the fine-tuning, {} of its moves shortened against slivers\n",
                     grouped(r.splits), grouped(r.collapses), grouped(r.flips), grouped(r.repairs),
@@ -132,6 +135,11 @@ void add_remesh_command(CLI::App& app) {
                   "Spacing of the boundary vertices in l, set after the first cycle (<= 1: as the "
                   "cycles leave it)")
       ->check(CLI::Range(0.0, 4.0 / 3.0))
+      ->capture_default_str();
+  cmd->add_option("--feature-angle", o.feature_angle_deg,
+                  "Keep the input's feature lines: edges whose faces' normals differ by more than "
+                  "this many degrees (0 = none)")
+      ->check(CLI::Range(0.0, 179.0))
       ->capture_default_str();
   cmd->add_option("--threads", o.threads, "Worker threads (default: all)")
       ->check(CLI::NonNegativeNumber);

@@ -89,6 +89,27 @@ SurfacePoint walk_to_closest(const Mesh& mesh, const Vec3& q, FaceHandle start, 
   return {f, closest.bary};
 }
 
+namespace {
+
+// The point (1 - t) from(h) + t to(h) on the face of h, or on the face across h when h is a
+// boundary halfedge.
+BoundaryPoint point_on_halfedge(const Mesh& mesh, HalfedgeHandle h, double t) {
+  BoundaryPoint result;
+  result.halfedge = h;
+  result.t = t;
+  result.point.face = mesh.is_boundary(h) ? mesh.face_handle(mesh.opposite_halfedge_handle(h))
+                                          : mesh.face_handle(h);
+  const VertexHandle from = mesh.from_vertex_handle(h);
+  const VertexHandle to = mesh.to_vertex_handle(h);
+  const std::array<VertexHandle, 3> corners = face_vertices(mesh, result.point.face);
+  for (std::size_t k = 0; k < 3; ++k) {
+    result.point.bary[k] = corners[k] == from ? 1.0 - t : corners[k] == to ? t : 0.0;
+  }
+  return result;
+}
+
+} // namespace
+
 BoundaryPoint walk_to_closest_on_boundary(const Mesh& mesh, const Vec3& q, HalfedgeHandle start,
                                           int max_steps) {
   require_query("walk_to_closest_on_boundary", q, max_steps);
@@ -123,19 +144,58 @@ BoundaryPoint walk_to_closest_on_boundary(const Mesh& mesh, const Vec3& q, Halfe
     h = best_halfedge;
     current = best;
   }
-  BoundaryPoint result;
-  result.halfedge = h;
-  result.t = current.t;
-  result.point.face = mesh.face_handle(mesh.opposite_halfedge_handle(h));
-  const VertexHandle from = mesh.from_vertex_handle(h);
-  const VertexHandle to = mesh.to_vertex_handle(h);
-  const std::array<VertexHandle, 3> corners = face_vertices(mesh, result.point.face);
-  for (std::size_t k = 0; k < 3; ++k) {
-    result.point.bary[k] = corners[k] == from ? 1.0 - current.t
-                           : corners[k] == to ? current.t
-                                              : 0.0;
+  return point_on_halfedge(mesh, h, current.t);
+}
+
+BoundaryPoint walk_to_closest_on_curve(const Mesh& mesh, const Vec3& q, HalfedgeHandle start,
+                                       const std::vector<char>& on_curve, int max_steps) {
+  require_query("walk_to_closest_on_curve", q, max_steps);
+  if (on_curve.size() != mesh.n_edges())
+    throw InvalidArgument("walk_to_closest_on_curve: on_curve has " +
+                          std::to_string(on_curve.size()) + " entries for " +
+                          std::to_string(mesh.n_edges()) + " edges; pass one per edge");
+  const auto marked = [&](HalfedgeHandle h) {
+    return on_curve[static_cast<std::size_t>(h.idx() / 2)] != 0 && !mesh.status(h).deleted();
+  };
+  if (!start.is_valid() || start.idx() >= static_cast<int>(mesh.n_halfedges()) || !marked(start))
+    throw InvalidArgument("walk_to_closest_on_curve: halfedge " + std::to_string(start.idx()) +
+                          " is not a live halfedge of an edge marked in on_curve");
+  // The chain's other marked halfedge at v, leaving v (`out`) or reaching it; invalid where the
+  // chain ends (v has one marked edge, or more than two).
+  const auto other = [&](VertexHandle v, HalfedgeHandle not_this, bool out) {
+    HalfedgeHandle found;
+    int count = 0;
+    for (auto g : mesh.voh_range(v)) {
+      if (!marked(g)) continue;
+      ++count;
+      if (mesh.edge_handle(g) != mesh.edge_handle(not_this)) found = g;
+    }
+    if (count != 2) return HalfedgeHandle();
+    return out ? found : mesh.opposite_halfedge_handle(found);
+  };
+  const auto closest = [&mesh, &q](HalfedgeHandle h) {
+    return closest_point_on_segment(q, mesh.point(mesh.from_vertex_handle(h)),
+                                    mesh.point(mesh.to_vertex_handle(h)));
+  };
+  HalfedgeHandle h = start;
+  SegmentClosest current = closest(h);
+  for (int step = 0; step < max_steps; ++step) {
+    HalfedgeHandle best_halfedge = h;
+    SegmentClosest best = current;
+    for (const HalfedgeHandle n :
+         {other(mesh.to_vertex_handle(h), h, true), other(mesh.from_vertex_handle(h), h, false)}) {
+      if (!n.is_valid()) continue;
+      const SegmentClosest candidate = closest(n);
+      if (candidate.distance2 < best.distance2) {
+        best = candidate;
+        best_halfedge = n;
+      }
+    }
+    if (best_halfedge == h || !improves(best.distance2, current.distance2)) break;
+    h = best_halfedge;
+    current = best;
   }
-  return result;
+  return point_on_halfedge(mesh, h, current.t);
 }
 
 } // namespace remora

@@ -11,6 +11,8 @@
 // Thread-safe for concurrent calls on the same const mesh; nothing is allocated.
 #pragma once
 
+#include <vector>
+
 #include "remora/mesh/mesh.h"
 #include "remora/mesh/surface_point.h"
 
@@ -42,5 +44,18 @@ struct BoundaryPoint {
 /// a boundary halfedge or has no face on its other side, if q is not finite, or if max_steps < 0.
 BoundaryPoint walk_to_closest_on_boundary(const Mesh& mesh, const Vec3& q, HalfedgeHandle start,
                                           int max_steps = 64);
+
+/// The closest point to q on the curve through `start`: a chain of the edges marked in
+/// `on_curve` (indexed by edge idx(), of size n_edges(); boundary edges and feature lines, for
+/// the remesher). A chain goes on through every vertex with exactly two marked edges and ends
+/// at a vertex with one or more than two. From h = start, each step moves to the chain's next
+/// or previous halfedge (oriented as h) nearest to q if it is closer than h by more than a
+/// relative 1e-12 of the squared distance; it stops when neither is, or after max_steps moves.
+/// The result's `point` lies on the face of `halfedge`, or on the face across it when
+/// `halfedge` is a boundary halfedge, with the third vertex's weight exactly 0. Throws
+/// InvalidArgument if on_curve has the wrong size, if start is not a live, marked halfedge of
+/// mesh, if q is not finite, or if max_steps < 0.
+BoundaryPoint walk_to_closest_on_curve(const Mesh& mesh, const Vec3& q, HalfedgeHandle start,
+                                       const std::vector<char>& on_curve, int max_steps = 64);
 
 } // namespace remora

@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <string>
+
+#include "remora/common/error.h"
 
 namespace remora {
 namespace {
@@ -148,6 +151,27 @@ double mean_edge_length(const Mesh& mesh) {
     ++n;
   }
   return n > 0 ? sum / static_cast<double>(n) : 0.0;
+}
+
+std::vector<char> feature_edges(const Mesh& mesh, double angle_deg) {
+  if (!(angle_deg >= 0.0 && angle_deg < 180.0))
+    throw InvalidArgument("feature_edges: the angle must be in [0, 180) degrees (got " +
+                          std::to_string(angle_deg) + ")");
+  const double cos_limit = std::cos(angle_deg * std::numbers::pi / 180.0);
+  std::vector<char> sharp(mesh.n_edges(), 0);
+  auto normal = [&mesh](FaceHandle f) {
+    const auto p = face_points(mesh, f);
+    return OpenMesh::cross(p[1] - p[0], p[2] - p[0]);
+  };
+  for (auto e : mesh.edges()) {
+    if (mesh.is_boundary(e)) continue;
+    const Vec3 n0 = normal(mesh.face_handle(mesh.halfedge_handle(e, 0)));
+    const Vec3 n1 = normal(mesh.face_handle(mesh.halfedge_handle(e, 1)));
+    const double lengths = n0.norm() * n1.norm();
+    if (!(lengths > 0)) continue;
+    sharp[static_cast<std::size_t>(e.idx())] = OpenMesh::dot(n0, n1) < cos_limit * lengths;
+  }
+  return sharp;
 }
 
 LengthScale length_scale(const Mesh& mesh) {

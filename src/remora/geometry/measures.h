@@ -6,6 +6,7 @@
 #pragma once
 
 #include <array>
+#include <vector>
 
 #include <Eigen/Core>
 
@@ -47,10 +48,15 @@ Eigen::VectorXd vertex_areas_barycentric(const Mesh& mesh);
 /// vertex-area vectors sum to surface_area() to round-off.
 Eigen::VectorXd vertex_areas_mixed(const Mesh& mesh);
 
-/// Axis-aligned bounding box of all non-deleted vertices (isolated ones included). A mesh without
-/// vertices gives min = max = (0, 0, 0).
 /// Mean length of the mesh's edges (0 for a mesh without edges).
 double mean_edge_length(const Mesh& mesh);
+
+/// The feature (crease) edges: per edge idx(), 1 for an interior edge whose two faces' normals
+/// differ by more than `angle_deg` degrees (its dihedral angle is sharper than 180 − angle_deg),
+/// else 0. A face with zero area in double precision has no normal and makes no edge a feature;
+/// boundary and deleted edges are 0. Throws InvalidArgument unless 0 <= angle_deg < 180 (at 0
+/// every edge between two faces that are not coplanar and equally oriented is a feature).
+std::vector<char> feature_edges(const Mesh& mesh, double angle_deg);
 
 /// The mesh's length scale, from which remesh() derives its default target length and the
 /// base-surface filter its σ: the mean edge length, unless needles inflate it. The edge length
@@ -65,6 +71,8 @@ struct LengthScale {
 };
 LengthScale length_scale(const Mesh& mesh);
 
+/// Axis-aligned bounding box of all non-deleted vertices (isolated ones included). A mesh without
+/// vertices gives min = max = (0, 0, 0).
 struct BoundingBox {
   Vec3 min{0.0, 0.0, 0.0};
   Vec3 max{0.0, 0.0, 0.0};

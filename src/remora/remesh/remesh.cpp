@@ -27,6 +27,10 @@ using Clock = std::chrono::steady_clock;
 // spatially (copy_in_order).
 constexpr std::size_t kSpatialOrderFaces = 32768;
 
+// Slivers below this angle (5 degrees) between two curves may merge two curve vertices
+// (Remesher::repair_pass).
+constexpr double kFlatRepairRad = 5.0 * M_PI / 180.0;
+
 double ms_since(Clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
 }
@@ -41,13 +45,13 @@ HalfedgeHandle boundary_out(const Mesh& mesh, VertexHandle v) {
 // What each output vertex is allowed to do.
 enum class Kind : std::uint8_t {
   Interior, // moves tangentially, projected onto the input surface
-  Boundary, // slides along the input boundary
-  Corner,   // never moves (a sharp boundary corner)
+  Curve,    // slides along an input curve: the boundary or a feature line
+  Corner,   // never moves (a sharp corner of a curve, or where feature lines meet or end)
 };
 
 // Where copy_in_order took each element of the copy from: old index by new index.
 struct MeshOrder {
-  std::vector<int> vertices, faces;
+  std::vector<int> vertices, edges, faces;
 };
 
 // A compacted copy of `mesh` (its deleted elements left out): with `spatially`, the vertices are
@@ -151,6 +155,7 @@ Mesh copy_in_order(const Mesh& mesh, bool spatially, MeshOrder& order) {
       if (f.is_valid())
         out.set_face_handle(hn, FaceHandle(fmap[static_cast<std::size_t>(f.idx())]));
     }
+  order.edges = std::move(edge_order);
   order.vertices.resize(nv);
   for (std::size_t r = 0; r < nv; ++r) {
     order.vertices[r] = static_cast<int>(keyed[r].second);
@@ -212,6 +217,7 @@ public:
       });
 
     init_locations();
+    report.feature_edges = feature_count_;
     init_points();
     for (int cycle = 0; cycle < options_.cycles; ++cycle) {
       progress("remesh", cycle, options_.cycles);
@@ -266,6 +272,7 @@ public:
     mesh_.remove_property(loc_prop_);
     mesh_.remove_property(bloc_prop_);
     mesh_.remove_property(kind_prop_);
+    mesh_.remove_property(feature_prop_);
     mesh_.remove_property(points_prop_);
     result.mesh = std::move(mesh_);
     report.milliseconds["total"] = ms_since(t_total);
@@ -279,9 +286,21 @@ private:
 
   // --- the correspondence -------------------------------------------------------------------
 
-  // Every output vertex starts as its input vertex: at a corner of an incident face, and on the
-  // boundary at its outgoing boundary halfedge.
+  // Every output vertex starts as its input vertex: at a corner of an incident face, and on a
+  // curve at an outgoing halfedge of it (on the boundary its outgoing boundary halfedge).
   void init_locations() {
+    // The input's curves: its boundary and, with feature_angle_deg, its feature lines. The
+    // working mesh starts as a copy, with the same handles.
+    input_curve_ = options_.feature_angle_deg > 0
+                       ? feature_edges(input_, options_.feature_angle_deg)
+                       : std::vector<char>(input_.n_edges(), 0);
+    for (auto e : input_.edges())
+      if (input_.is_boundary(e)) input_curve_[static_cast<std::size_t>(e.idx())] = 1;
+    if (options_.feature_angle_deg > 0) prune_short_lines();
+    for (auto e : input_.edges()) {
+      feature(e) = input_curve_[static_cast<std::size_t>(e.idx())] && !input_.is_boundary(e);
+      feature_count_ += feature(e);
+    }
     for (auto v : mesh_.vertices()) {
       kind(v) = Kind::Interior;
       if (mesh_.is_isolated(v)) {
@@ -296,56 +315,162 @@ private:
       sp.bary = {fv[0] == v ? 1.0 : 0.0, fv[1] == v ? 1.0 : 0.0, fv[2] == v ? 1.0 : 0.0};
       loc(v) = sp;
       if (mesh_.is_boundary(v)) {
-        kind(v) = Kind::Boundary;
+        kind(v) = Kind::Curve;
         bloc(v) = boundary_out(input_, v);
+      } else if (feature_count_ > 0) {
+        for (auto h : input_.voh_range(v))
+          if (input_curve_[static_cast<std::size_t>(h.idx() / 2)]) {
+            kind(v) = Kind::Curve;
+            bloc(v) = h;
+            break;
+          }
       }
     }
     mark_corners();
   }
 
-  // A boundary corner is where the boundary turns sharply at the scale of the target length:
-  // the turn at v is measured between the chords to the boundary points about l/2 before and
-  // after it, so that the zigzag of a scanned hole (sharp at the scale of its own edges) is not
-  // a corner while a CAD corner is; of the vertices around one corner only the sharpest is kept.
+  // A feature line of the input: its vertices, from an end (a vertex with other than two curve
+  // edges) to an end, or around a loop (`closed`, the first vertex not repeated).
+  struct Line {
+    std::vector<VertexHandle> vertices;
+    std::vector<EdgeHandle> edges;
+    bool closed = false;
+  };
+
+  // The input's feature lines (input_curve_ without the boundary), each once.
+  std::vector<Line> feature_lines() const {
+    std::vector<int> degree(input_.n_vertices(), 0);
+    for (auto v : input_.vertices()) degree[static_cast<std::size_t>(v.idx())] = curve_degree(v);
+    std::vector<char> seen(input_.n_edges(), 0);
+    std::vector<Line> lines;
+    auto trace = [&](HalfedgeHandle h) {
+      Line line;
+      line.vertices.push_back(input_.from_vertex_handle(h));
+      while (true) {
+        seen[static_cast<std::size_t>(h.idx() / 2)] = 1;
+        line.edges.push_back(input_.edge_handle(h));
+        const VertexHandle v = input_.to_vertex_handle(h);
+        if (v == line.vertices.front()) {
+          line.closed = true;
+          break;
+        }
+        line.vertices.push_back(v);
+        if (degree[static_cast<std::size_t>(v.idx())] != 2) break;
+        HalfedgeHandle next;
+        for (auto g : input_.voh_range(v))
+          if (input_curve_[static_cast<std::size_t>(g.idx() / 2)] &&
+              input_.edge_handle(g) != input_.edge_handle(h))
+            next = g;
+        h = next;
+      }
+      lines.push_back(std::move(line));
+    };
+    // Open lines from their ends first; what is left are loops.
+    for (int pass = 0; pass < 2; ++pass)
+      for (auto v : input_.vertices()) {
+        const int d = degree[static_cast<std::size_t>(v.idx())];
+        if (d == 0 || (pass == 0 && d == 2)) continue;
+        for (auto h : input_.voh_range(v)) {
+          const std::size_t e = static_cast<std::size_t>(h.idx() / 2);
+          if (input_curve_[e] && !seen[e] && !input_.is_boundary(input_.edge_handle(h))) trace(h);
+        }
+      }
+    return lines;
+  }
+
+  // Drops the feature lines shorter than l, until none is left: between two corners closer
+  // than that, no edge can be in the band, and where lines meet at such distances (the teeth of
+  // gears.stl, the facets of a coarse cylinder) their corners pin slivers. Features smaller
+  // than the target length are lost anyway.
+  void prune_short_lines() {
+    for (int pass = 0; pass < 16; ++pass) {
+      bool pruned = false;
+      for (const Line& line : feature_lines()) {
+        double length = 0;
+        for (EdgeHandle e : line.edges) length += input_.calc_edge_length(e);
+        if (length >= length_) continue;
+        for (EdgeHandle e : line.edges) input_curve_[static_cast<std::size_t>(e.idx())] = 0;
+        pruned = true;
+      }
+      if (!pruned) break;
+    }
+  }
+
+  // The number of input curve edges (boundary or feature) at v.
+  int curve_degree(VertexHandle v) const {
+    int n = 0;
+    for (auto h : input_.voh_range(v)) n += input_curve_[static_cast<std::size_t>(h.idx() / 2)];
+    return n;
+  }
+
+  // Marks as corners the vertices of `vs` (a curve of the input, closed or open) where it turns
+  // sharply at the scale of the target length: the turn at v is measured between the chords to
+  // the curve's points about l/2 before and after it, so that the zigzag of a scanned hole
+  // (sharp at the scale of its own edges) is not a corner while a CAD corner is; of the vertices
+  // around one corner only the sharpest is kept, and none within l/2 of a vertex where feature
+  // lines end or meet (which is a corner already: blade.off has a boundary turn 0.03 l from
+  // where a feature line meets the boundary, and the edge between two corners cannot go).
+  void mark_turns(const std::vector<VertexHandle>& vs, bool closed, double corner_cos) {
+    const double reach2 = 0.25 * length_ * length_;
+    const std::size_t n = vs.size();
+    if (n < 3) return;
+    std::vector<double> turn(n, 1.0); // cosine of the turning angle; lower is sharper
+    std::vector<std::size_t> before(n), after(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      before[i] = after[i] = i;
+      if (!closed && (i == 0 || i + 1 == n)) continue;
+      const Vec3 p = input_.point(vs[i]);
+      std::size_t b = (i + n - 1) % n, a = (i + 1) % n;
+      if (closed) {
+        while (b != a && (input_.point(vs[b]) - p).sqrnorm() < reach2) b = (b + n - 1) % n;
+        while (a != b && (input_.point(vs[a]) - p).sqrnorm() < reach2) a = (a + 1) % n;
+      } else {
+        while (b > 0 && (input_.point(vs[b]) - p).sqrnorm() < reach2) --b;
+        while (a + 1 < n && (input_.point(vs[a]) - p).sqrnorm() < reach2) ++a;
+      }
+      before[i] = b;
+      after[i] = a;
+      const Vec3 d_in = p - input_.point(vs[b]), d_out = input_.point(vs[a]) - p;
+      const double len = d_in.norm() * d_out.norm();
+      turn[i] = len > 0 ? OpenMesh::dot(d_in, d_out) / len : 1.0;
+    }
+    for (std::size_t i = 0; i < n; ++i) {
+      if (turn[i] >= corner_cos) continue;
+      // Non-maximum suppression over the same window (ties go to the lower index).
+      bool sharpest = true;
+      for (std::size_t j = before[i]; j != after[i] && sharpest; j = (j + 1) % n)
+        if (j != i && (turn[j] < turn[i] || (turn[j] == turn[i] && j < i))) sharpest = false;
+      if (feature_count_ > 0)
+        for (std::size_t j = before[i]; j != (after[i] + 1) % n && sharpest; j = (j + 1) % n)
+          if (curve_degree(vs[j]) != 2) sharpest = false;
+      if (sharpest) kind(vs[i]) = Kind::Corner;
+    }
+  }
+
+  // Corners: where a curve turns sharply (mark_turns), and where feature lines end or meet, each
+  // other or the boundary (a curve vertex with other than two curve edges).
   void mark_corners() {
     const double corner_cos = std::cos(options_.corner_angle_deg * M_PI / 180.0);
-    const double reach2 = 0.25 * length_ * length_;
     const auto loops = boundary_loops(input_);
     has_boundary_ = !loops.empty();
     for (const auto& loop : loops) {
-      const std::size_t n = loop.size();
-      if (n < 3) continue;
-      std::vector<VertexHandle> vs(n);
-      for (std::size_t i = 0; i < n; ++i) vs[i] = input_.from_vertex_handle(loop[i]);
-      std::vector<double> turn(n, -2.0); // cosine of the turning angle; lower is sharper
-      std::vector<std::size_t> before(n), after(n);
-      for (std::size_t i = 0; i < n; ++i) {
-        const Vec3 p = input_.point(vs[i]);
-        std::size_t b = (i + n - 1) % n, a = (i + 1) % n;
-        while (b != a && (input_.point(vs[b]) - p).sqrnorm() < reach2) b = (b + n - 1) % n;
-        while (a != b && (input_.point(vs[a]) - p).sqrnorm() < reach2) a = (a + 1) % n;
-        before[i] = b;
-        after[i] = a;
-        const Vec3 d_in = p - input_.point(vs[b]), d_out = input_.point(vs[a]) - p;
-        const double len = d_in.norm() * d_out.norm();
-        turn[i] = len > 0 ? OpenMesh::dot(d_in, d_out) / len : 1.0;
-      }
-      for (std::size_t i = 0; i < n; ++i) {
-        if (turn[i] >= corner_cos) continue;
-        // Non-maximum suppression over the same window (ties go to the lower index).
-        bool sharpest = true;
-        for (std::size_t j = before[i]; j != after[i] && sharpest; j = (j + 1) % n)
-          if (j != i && (turn[j] < turn[i] || (turn[j] == turn[i] && j < i))) sharpest = false;
-        if (sharpest) kind(vs[i]) = Kind::Corner;
-      }
+      std::vector<VertexHandle> vs(loop.size());
+      for (std::size_t i = 0; i < loop.size(); ++i) vs[i] = input_.from_vertex_handle(loop[i]);
+      mark_turns(vs, true, corner_cos);
     }
+    if (feature_count_ == 0) return;
+    for (auto v : input_.vertices()) {
+      const int degree = curve_degree(v);
+      if (degree > 0 && degree != 2) kind(v) = Kind::Corner;
+    }
+    for (const Line& line : feature_lines()) mark_turns(line.vertices, line.closed, corner_cos);
   }
 
   // Finds where `p` lies on the input, starting from the location of `near`, and returns the
   // point to place the vertex at (the projection when projecting).
   Vec3 relocate(VertexHandle v, const Vec3& p, VertexHandle near) {
     if (kind(near) != Kind::Interior && kind(v) != Kind::Interior) {
-      const BoundaryPoint bp = walk_to_closest_on_boundary(input_, p, bloc(near));
+      const BoundaryPoint bp = walk_to_closest_on_curve(input_, p, bloc(near), input_curve_);
       loc(v) = bp.point;
       bloc(v) = bp.halfedge;
     } else {
@@ -443,6 +568,11 @@ private:
     std::vector<SurfacePoint> locs(nv);
     std::vector<HalfedgeHandle> blocs(nv);
     std::vector<Kind> kinds(nv);
+    std::vector<char> old_features;
+    if (feature_count_ > 0) {
+      old_features.resize(mesh_.n_edges());
+      for (auto e : mesh_.edges()) old_features[static_cast<std::size_t>(e.idx())] = feature(e);
+    }
     for (std::size_t r = 0; r < nv; ++r) {
       const VertexHandle v(order.vertices[r]);
       locs[r] = loc(v);
@@ -458,6 +588,13 @@ private:
       kind(v) = kinds[r];
     }
     for (std::size_t r = 0; r < nf; ++r) points(FaceHandle(static_cast<int>(r))) = lists[r];
+    if (feature_count_ > 0) {
+      std::vector<char> features(order.edges.size());
+      for (std::size_t r = 0; r < features.size(); ++r)
+        features[r] = old_features[static_cast<std::size_t>(order.edges[r])];
+      for (std::size_t r = 0; r < features.size(); ++r)
+        feature(EdgeHandle(static_cast<int>(r))) = features[r];
+    }
     rebind_points();
     live_faces_ = mesh_.n_faces();
   }
@@ -726,19 +863,52 @@ private:
         const Vec3 pa = mesh_.point(a), pb = mesh_.point(b);
         if ((pa - pb).sqrnorm() <= hi2_) continue;
         const bool on_boundary = mesh_.is_boundary(e);
+        const bool on_feature = feature(e);
         const VertexHandle v = mesh_.split(e, (pa + pb) * 0.5);
         live_faces_ += on_boundary ? 1 : 2;
-        kind(v) = on_boundary ? Kind::Boundary : Kind::Interior;
-        // On the boundary, start from an endpoint that lies on the input boundary.
-        const VertexHandle near = on_boundary && kind(a) == Kind::Interior ? b : a;
+        kind(v) = on_boundary || on_feature ? Kind::Curve : Kind::Interior;
+        // On a curve, start from an endpoint that slides along it; between two corners, from
+        // the curve edge of the input at a that is closest to the midpoint. With feature lines
+        // this matters on the boundary too: the walk along a curve stops where lines meet, and
+        // from the corner's own boundary halfedge, which may leave it the other way, the new
+        // vertex would stay on the corner (the bunny at 45 degrees: zero-length edges).
+        const bool lines = feature_count_ > 0 && (on_feature || on_boundary);
+        const VertexHandle near = lines && kind(a) == Kind::Corner ? b : a;
         loc(v) = loc(near);
         bloc(v) = bloc(near);
+        if (lines && kind(near) == Kind::Corner) bloc(v) = curve_start(near, (pa + pb) * 0.5);
+        if (on_feature) {
+          for (auto g : mesh_.voh_range(v)) {
+            const VertexHandle w = mesh_.to_vertex_handle(g);
+            feature(mesh_.edge_handle(g)) = w == a || w == b;
+          }
+        } else if (feature_count_ > 0) {
+          for (auto g : mesh_.voh_range(v)) feature(mesh_.edge_handle(g)) = 0;
+        }
         ++made;
       }
       count += made;
       if (made == 0 || live_faces_ >= max_faces_) break;
     }
     return count;
+  }
+
+  // The input curve halfedge leaving corner c's input vertex whose segment is closest to p.
+  HalfedgeHandle curve_start(VertexHandle c, const Vec3& p) const {
+    const VertexHandle x = input_.from_vertex_handle(mesh_.property(bloc_prop_, c));
+    HalfedgeHandle best;
+    double best_d2 = std::numeric_limits<double>::max();
+    for (auto h : input_.voh_range(x)) {
+      if (!input_curve_[static_cast<std::size_t>(h.idx() / 2)]) continue;
+      const double d2 =
+          closest_point_on_segment(p, input_.point(x), input_.point(input_.to_vertex_handle(h)))
+              .distance2;
+      if (d2 < best_d2) {
+        best_d2 = d2;
+        best = h;
+      }
+    }
+    return best.is_valid() ? best : mesh_.property(bloc_prop_, c);
   }
 
   // Does collapsing h (its source into its target) keep the mesh a manifold? The link condition
@@ -854,7 +1024,8 @@ private:
     return count;
   }
 
-  enum class Collapse { Short, Repair, Boundary };
+  // Flat: a repair of a sliver between two curves (below), which may merge two of their vertices.
+  enum class Collapse { Short, Repair, Boundary, Flat };
 
   // Collapses e if the rules allow it: corners never go, an interior vertex goes onto a boundary
   // vertex (which stays put), two boundary vertices merge along a boundary edge only, and the
@@ -868,12 +1039,18 @@ private:
     // Which endpoint goes, and where the survivor ends up.
     bool midpoint = true;
     if (ka == Kind::Corner && kb == Kind::Corner) return false;
-    if (ka != Kind::Interior && kb != Kind::Interior && !mesh_.is_boundary(e)) return false;
-    if (ka == Kind::Corner || (ka == Kind::Boundary && kb == Kind::Interior)) {
+    if (ka != Kind::Interior && kb != Kind::Interior && !on_curve(e)) {
+      if (purpose != Collapse::Flat) return false;
+      if (kb != Kind::Corner) { // keep a corner where it is, else b
+        h = mesh_.opposite_halfedge_handle(h);
+        std::swap(a, b);
+      }
+      midpoint = false;
+    } else if (ka == Kind::Corner || (ka == Kind::Curve && kb == Kind::Interior)) {
       h = mesh_.opposite_halfedge_handle(h); // remove b, keep a where it is
       std::swap(a, b);
       midpoint = false;
-    } else if (kb == Kind::Corner || (kb == Kind::Boundary && ka == Kind::Interior)) {
+    } else if (kb == Kind::Corner || (kb == Kind::Curve && ka == Kind::Interior)) {
       midpoint = false; // remove a, keep b where it is
     }
     Vec3 target = midpoint ? (mesh_.point(a) + mesh_.point(b)) * 0.5 : mesh_.point(b);
@@ -881,9 +1058,9 @@ private:
     // Laplacian less than a sliver), and must raise the smallest angle around it. The length
     // test comes first: it is the cheapest and the one that fails most (two thirds of the short
     // edges of a cycle cannot go without leaving an edge longer than 4/3 l).
-    const double reach2 = purpose == Collapse::Short    ? hi2_
-                          : purpose == Collapse::Repair ? 1.4 * hi2_
-                                                        : 4 * hi2_;
+    const double reach2 = purpose == Collapse::Short                                 ? hi2_
+                          : purpose == Collapse::Repair || purpose == Collapse::Flat ? 1.4 * hi2_
+                                                                                     : 4 * hi2_;
     bool ok = neighbours_within(a, b, target, reach2);
     if (ok && !collapse_keeps_manifold(h)) {
       if (!midpoint) return false;
@@ -893,7 +1070,8 @@ private:
       if (!ok && purpose != Collapse::Repair) return false;
     }
     ok = ok && collapse_keeps_orientation(h, target) &&
-         (purpose != Collapse::Repair || collapse_raises_min_angle(h, target));
+         ((purpose != Collapse::Repair && purpose != Collapse::Flat) ||
+          collapse_raises_min_angle(h, target));
     if (!ok) {
       // A repair of an interior edge may also collapse it into either endpoint, which stays
       // where it is, on the input: on a crease (gears.stl at 0.6 l) the midpoint can be the
@@ -910,10 +1088,25 @@ private:
       if (!ok) return false;
     }
     live_faces_ -= mesh_.is_boundary(e) ? 1 : 2;
-    // The two faces of the edge go: their input vertices move to the survivor's faces.
-    for (auto side : {h, mesh_.opposite_halfedge_handle(h)})
-      if (!mesh_.is_boundary(side)) take_points(mesh_.face_handle(side), displaced_);
+    // The two faces of the edge go: their input vertices move to the survivor's faces. In each,
+    // the edges from a and b to the tip merge; the merged edge is a feature if either was.
+    VertexHandle tips[2];
+    char merged[2] = {0, 0};
+    int n_tips = 0;
+    for (auto side : {h, mesh_.opposite_halfedge_handle(h)}) {
+      if (mesh_.is_boundary(side)) continue;
+      take_points(mesh_.face_handle(side), displaced_);
+      if (feature_count_ == 0) continue;
+      const HalfedgeHandle n1 = mesh_.next_halfedge_handle(side);
+      tips[n_tips] = mesh_.to_vertex_handle(n1);
+      merged[n_tips++] = feature(mesh_.edge_handle(n1)) ||
+                         feature(mesh_.edge_handle(mesh_.next_halfedge_handle(n1)));
+    }
     mesh_.collapse(h);
+    for (int t = 0; t < n_tips; ++t) {
+      const HalfedgeHandle kept = mesh_.find_halfedge(b, tips[t]);
+      if (kept.is_valid()) feature(mesh_.edge_handle(kept)) = merged[t];
+    }
     if (midpoint) mesh_.set_point(b, purpose == Collapse::Repair ? relocate(b, target, b) : target);
     place_points_around(b, displaced_);
     return true;
@@ -982,7 +1175,7 @@ private:
       if (min_angle(fv[0], fv[1], fv[2]) >= min_rad) continue;
       const int longest = static_cast<int>(std::max_element(len, len + 3) - len);
       const EdgeHandle el = mesh_.edge_handle(hs[longest]);
-      if (!mesh_.is_boundary(el) && mesh_.is_flip_ok(el)) {
+      if (!on_curve(el) && mesh_.is_flip_ok(el)) {
         const HalfedgeHandle h0 = mesh_.halfedge_handle(el, 0), h1 = mesh_.halfedge_handle(el, 1);
         const VertexHandle a = mesh_.to_vertex_handle(h0), b = mesh_.to_vertex_handle(h1);
         const VertexHandle c = mesh_.to_vertex_handle(mesh_.next_halfedge_handle(h0));
@@ -1001,12 +1194,24 @@ private:
       }
       // A flat face (three corners on a line, as on a sharp crease) is worth any collapse of
       // its edges that the rules allow, the other two included.
-      if (face_cross(f).norm() > 1e-6 * length_ * length_) continue;
-      for (int k : {(shortest + 1) % 3, (shortest + 2) % 3})
-        if (try_collapse(mesh_.edge_handle(hs[k]), Collapse::Repair)) {
-          ++count;
-          break;
-        }
+      if (face_cross(f).norm() <= 1e-6 * length_ * length_) {
+        bool done = false;
+        for (int k : {(shortest + 1) % 3, (shortest + 2) % 3})
+          if (!done && try_collapse(mesh_.edge_handle(hs[k]), Collapse::Repair)) {
+            ++count;
+            done = true;
+          }
+        if (done) continue;
+      }
+      // With feature lines, a sliver between two curves that no legal operation fixes (two
+      // lines that leave a corner 0.5 degrees apart, a line folded back on itself: scan noise
+      // at 45 degrees) is worth merging two of its curve vertices, the corner kept if one is.
+      if (feature_count_ > 0 && min_angle(fv[0], fv[1], fv[2]) < kFlatRepairRad)
+        for (int k : {shortest, (shortest + 1) % 3, (shortest + 2) % 3})
+          if (try_collapse(mesh_.edge_handle(hs[k]), Collapse::Flat)) {
+            ++count;
+            break;
+          }
     }
     return count;
   }
@@ -1032,7 +1237,7 @@ private:
     const std::size_t n = mesh_.n_edges();
     for (std::size_t i = 0; i < n; ++i) {
       const EdgeHandle e(static_cast<int>(i));
-      if (mesh_.status(e).deleted() || mesh_.is_boundary(e)) continue;
+      if (mesh_.status(e).deleted() || on_curve(e)) continue;
       const HalfedgeHandle h0 = mesh_.halfedge_handle(e, 0), h1 = mesh_.halfedge_handle(e, 1);
       const VertexHandle a = mesh_.to_vertex_handle(h0), b = mesh_.to_vertex_handle(h1);
       const VertexHandle c = mesh_.to_vertex_handle(mesh_.next_halfedge_handle(h0));
@@ -1058,9 +1263,11 @@ private:
   }
 
   // The triangles (b, a, c) and (a, b, d) around edge ab become (a, c, d) and (c, b, d): both must
-  // face the way the pair did, and neither may be degenerate.
+  // face the way the pair did, and neither may be degenerate. Neither may span a feature line
+  // at a or b either (spans_line).
   bool flip_keeps_orientation(VertexHandle a, VertexHandle b, VertexHandle c,
                               VertexHandle d) const {
+    if (feature_count_ > 0 && (spans_line(a, c, d) || spans_line(b, c, d))) return false;
     const Vec3 pa = mesh_.point(a), pb = mesh_.point(b), pc = mesh_.point(c), pd = mesh_.point(d);
     const Vec3 n_old = OpenMesh::cross(pa - pb, pc - pb) + OpenMesh::cross(pb - pa, pd - pa);
     const Vec3 n1 = OpenMesh::cross(pc - pa, pd - pa);
@@ -1069,6 +1276,19 @@ private:
     if (n1.norm() <= tiny || n2.norm() <= tiny) return false;
     return OpenMesh::dot(n1, n_old) > 0 && OpenMesh::dot(n2, n_old) > 0 &&
            OpenMesh::dot(n1, n2) > 0.5 * n1.norm() * n2.norm();
+  }
+
+  // Would the triangle (v, c, d) have both of v's feature edges, v a vertex inside a line? The
+  // smoothing along the line puts v at the midpoint of c and d: on a straight line the triangle
+  // goes flat (the bunny at 45 degrees had 7 flat faces so).
+  bool spans_line(VertexHandle v, VertexHandle c, VertexHandle d) const {
+    if (kind(v) != Kind::Curve || mesh_.is_boundary(v)) return false;
+    int both = 0;
+    for (auto h : mesh_.voh_range(v)) {
+      const VertexHandle w = mesh_.to_vertex_handle(h);
+      if ((w == c || w == d) && feature(mesh_.edge_handle(h))) ++both;
+    }
+    return both == 2;
   }
 
   // Area-weighted vertex normal (zero for a vertex whose faces all have zero area).
@@ -1203,13 +1423,26 @@ private:
     return Placed::Dropped;
   }
 
-  // Where a boundary vertex goes: the midpoint of its two boundary neighbours, relaxed by
+  // Where a curve vertex goes: the midpoint of its two neighbours along the curve, relaxed by
   // `weight`.
-  bool boundary_target(VertexHandle v, double weight, Vec3& goal) const {
+  bool curve_target(VertexHandle v, double weight, Vec3& goal) const {
+    VertexHandle next, prev;
     const HalfedgeHandle out = boundary_out(mesh_, v);
-    if (!out.is_valid()) return false;
-    const VertexHandle next = mesh_.to_vertex_handle(out);
-    const VertexHandle prev = mesh_.from_vertex_handle(mesh_.prev_halfedge_handle(out));
+    if (out.is_valid()) {
+      next = mesh_.to_vertex_handle(out);
+      prev = mesh_.from_vertex_handle(mesh_.prev_halfedge_handle(out));
+    } else {
+      int n = 0;
+      for (auto h : mesh_.voh_range(v))
+        if (feature(mesh_.edge_handle(h))) (n++ == 0 ? next : prev) = mesh_.to_vertex_handle(h);
+      if (n != 2) return false;
+      // A face (prev, v, next) would go flat on a straight line: v stays (spans_line).
+      for (auto h : mesh_.voh_range(v))
+        if (!mesh_.is_boundary(h) &&
+            spans_line(v, mesh_.to_vertex_handle(h),
+                       mesh_.to_vertex_handle(mesh_.next_halfedge_handle(h))))
+          return false;
+    }
     const Vec3 mid = (mesh_.point(next) + mesh_.point(prev)) * 0.5;
     goal = mesh_.point(v) + (mid - mesh_.point(v)) * weight;
     return true;
@@ -1265,7 +1498,7 @@ private:
             1 + static_cast<std::size_t>((static_cast<double>(j) + 0.5) *
                                          static_cast<double>(m - 1) / static_cast<double>(remove));
         const VertexHandle v = run[std::min(i, m - 1)];
-        if (mesh_.status(v).deleted() || kind(v) != Kind::Boundary) continue;
+        if (mesh_.status(v).deleted() || kind(v) != Kind::Curve) continue;
         const HalfedgeHandle out = boundary_out(mesh_, v);
         if (!out.is_valid()) continue;
         collapsed += try_collapse(mesh_.edge_handle(out), Collapse::Boundary) ? 1 : 0;
@@ -1288,7 +1521,7 @@ private:
         const double t = span > 0 ? (s - at[k]) / span : 0.0;
         goal[static_cast<std::size_t>(run[i].idx())] =
             mesh_.point(run[k]) * (1 - t) + mesh_.point(run[k + 1]) * t;
-        has[static_cast<std::size_t>(run[i].idx())] = kind(run[i]) == Kind::Boundary;
+        has[static_cast<std::size_t>(run[i].idx())] = kind(run[i]) == Kind::Curve;
       }
     }
     move_vertices([&](VertexHandle v, Vec3& g) {
@@ -1301,7 +1534,7 @@ private:
 
   void tangential_smoothing() {
     move_vertices([&](VertexHandle v, Vec3& goal) {
-      if (kind(v) == Kind::Boundary) return boundary_target(v, 0.5, goal);
+      if (kind(v) == Kind::Curve) return curve_target(v, 0.5, goal);
       Vec3 centroid(0, 0, 0);
       int k = 0;
       for (auto w : mesh_.vv_range(v)) {
@@ -1337,7 +1570,7 @@ private:
     marked.assign(n, 0);
     parallel_for(n, options_.threads, [&](std::size_t i) {
       const EdgeHandle e(static_cast<int>(i));
-      if (mesh_.status(e).deleted() || mesh_.is_boundary(e)) return;
+      if (mesh_.status(e).deleted() || on_curve(e)) return;
       marked[i] = violates_delaunay(e) ? 1 : 0;
     });
     std::size_t count = 0;
@@ -1377,7 +1610,7 @@ private:
   void equalize_areas_gravity() {
     const Eigen::VectorXd area = vertex_areas_mixed(mesh_);
     move_vertices([&](VertexHandle v, Vec3& goal) {
-      if (kind(v) == Kind::Boundary) return false; // boundary vertices keep their spacing
+      if (kind(v) == Kind::Curve) return false; // curve vertices keep their spacing
       Vec3 g(0, 0, 0);
       double w = 0;
       for (auto u : mesh_.vv_range(v)) {
@@ -1431,7 +1664,7 @@ private:
     double sum = 0;
     std::size_t count = 0;
     for (auto v : mesh_.vertices())
-      if (kind(v) == Kind::Interior && !mesh_.is_isolated(v)) {
+      if (!mesh_.is_boundary(v) && !mesh_.is_isolated(v)) {
         sum += area[static_cast<std::size_t>(v.idx())];
         ++count;
       }
@@ -1459,7 +1692,7 @@ private:
       // on residuals that include the boundary vertices' (equalize_boundary; its placement then
       // keeps the edges to them in the band), or plain tangential smoothing.
       bool near_boundary = false;
-      for (int j = 0; j < k; ++j) near_boundary |= kind(ring[j]) != Kind::Interior;
+      for (int j = 0; j < k; ++j) near_boundary |= mesh_.is_boundary(ring[j]);
       r.boundary_band = near_boundary && options_.equalize_boundary;
       // The circulator turns one way: the third corner of face j is ring[j + 1] or ring[j - 1].
       const HalfedgeHandle h0 = *mesh_.cvoh_begin(v);
@@ -1511,14 +1744,15 @@ private:
         parts(p + t * eps, moved);
         for (int j = 0; j <= k; ++j) d[j] = (moved[j] - base[j]) / eps;
       }
-      // Residuals: v itself (index k) and the ring's interior vertices, with equalize_boundary
-      // its boundary vertices too (not the corners, whose cells are smaller still).
+      // Residuals: v itself (index k) and the ring's interior vertices (on feature lines too),
+      // with equalize_boundary its boundary vertices too (not the boundary's corners, whose
+      // cells are smaller still).
       Eigen::Matrix2d jtj = Eigen::Matrix2d::Zero();
       Eigen::Vector2d jtr = Eigen::Vector2d::Zero();
       for (int j = 0; j <= k; ++j) {
         const VertexHandle w = j == k ? v : ring[j];
         const Kind kw = kind(w);
-        if (kw == Kind::Corner || (kw == Kind::Boundary && !options_.equalize_boundary)) continue;
+        if (mesh_.is_boundary(w) && (kw == Kind::Corner || !options_.equalize_boundary)) continue;
         const Eigen::Vector2d row(d1[j], d2[j]);
         jtj += row * row.transpose();
         jtr += row * (area[static_cast<std::size_t>(w.idx())] - target);
@@ -1564,6 +1798,9 @@ private:
   OpenMesh::VPropHandleT<SurfacePoint> loc_prop_;    // where the vertex lies on the input
   OpenMesh::VPropHandleT<HalfedgeHandle> bloc_prop_; // boundary vertices: input boundary halfedge
   OpenMesh::VPropHandleT<Kind> kind_prop_;
+  OpenMesh::EPropHandleT<char> feature_prop_; // the edge lies on a feature line of the input
+  std::vector<char> input_curve_;             // per input edge: on the boundary or a feature line
+  std::size_t feature_count_ = 0;             // feature edges of the input
   // Input -> output (see take_points): per input vertex its location and list neighbours.
   OpenMesh::FPropHandleT<PointList> points_prop_;
   std::vector<SurfacePoint> track_;
@@ -1579,12 +1816,17 @@ private:
     mesh_.add_property(loc_prop_);
     mesh_.add_property(bloc_prop_);
     mesh_.add_property(kind_prop_);
+    mesh_.add_property(feature_prop_);
     mesh_.add_property(points_prop_);
   }
   SurfacePoint& loc(VertexHandle v) { return mesh_.property(loc_prop_, v); }
   HalfedgeHandle& bloc(VertexHandle v) { return mesh_.property(bloc_prop_, v); }
   Kind& kind(VertexHandle v) { return mesh_.property(kind_prop_, v); }
   Kind kind(VertexHandle v) const { return mesh_.property(kind_prop_, v); }
+  char& feature(EdgeHandle e) { return mesh_.property(feature_prop_, e); }
+  char feature(EdgeHandle e) const { return mesh_.property(feature_prop_, e); }
+  // Edges that flips leave alone and collapses keep on their curve.
+  bool on_curve(EdgeHandle e) const { return mesh_.is_boundary(e) || feature(e); }
   double length_ = 0, lo2_ = 0, hi_ = 0, hi2_ = 0;
   double guard_rad_ = 0, cos_guard_ = 1; // cosine of equalize_guard_deg
   std::size_t guarded_ = 0;              // moves the guard halved or dropped
@@ -1607,6 +1849,9 @@ RemeshResult remesh(const Mesh& input, const RemeshOptions& options) {
     throw InvalidArgument("remesh: lambda must be in (0, 1]");
   if (!(options.equalize_guard_deg >= 0 && options.equalize_guard_deg < 60))
     throw InvalidArgument("remesh: equalize_guard_deg must be in [0, 60) degrees (0 = off)");
+  if (!(options.feature_angle_deg >= 0 && options.feature_angle_deg < 180))
+    throw InvalidArgument("remesh: feature_angle_deg must be in [0, 180) degrees (0 = no "
+                          "features)");
   if (!(options.boundary_spacing <= 4.0 / 3.0))
     throw InvalidArgument("remesh: boundary_spacing must be at most 4/3 (longer boundary edges "
                           "are split again; <= 1 turns the spacing off)");
@@ -1639,6 +1884,7 @@ RemeshResult remesh(const Mesh& input, const RemeshOptions& options) {
 nlohmann::json to_json(const RemeshReport& r) {
   return {{"target_length", r.target_length},
           {"length_from_area", r.length_from_area},
+          {"feature_edges", r.feature_edges},
           {"input", to_json(r.input)},
           {"after_cycles", to_json(r.after_cycles)},
           {"after_equalization", to_json(r.after_equalization)},

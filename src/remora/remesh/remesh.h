@@ -70,8 +70,14 @@ struct RemeshOptions {
   /// After the cycles and after equalization, triangles with a smaller angle than this get their
   /// longest edge flipped or shortest edge collapsed where the rules allow.
   double repair_angle_deg = 25.0;
-  /// A boundary vertex whose boundary turns by more than this is a corner and never moves.
+  /// A curve vertex (boundary or feature line) where its curve turns by more than this, at the
+  /// scale of l, is a corner and never moves.
   double corner_angle_deg = 30.0;
+  /// Input edges whose faces' normals differ by more than this many degrees are features
+  /// (feature_edges() in geometry/measures.h): like the boundary, their lines are kept. Output
+  /// vertices on them slide only along them, their edges are never flipped, and where lines end
+  /// or meet, or turn by more than corner_angle_deg, a corner stays. 0 turns features off.
+  double feature_angle_deg = 0.0;
   /// Spacing of the boundary vertices, in l, set once after the first cycle: where a run of the
   /// boundary between corners has closer vertices, every so many are collapsed and the rest
   /// spaced evenly along it. Longer boundary edges give the boundary vertices larger cells
@@ -91,6 +97,7 @@ struct RemeshOptions {
 struct RemeshReport {
   double target_length = 0.0;
   bool length_from_area = false; ///< l came from the area per vertex (a needle-ridden input)
+  std::size_t feature_edges = 0; ///< input edges found sharper than feature_angle_deg
   MeshQuality input;
   MeshQuality after_cycles;
   MeshQuality after_equalization;
@@ -133,7 +140,7 @@ struct RemeshResult {
 
 /// Remeshes `input` (a repaired, manifold triangle mesh). Throws InvalidArgument for an empty
 /// mesh, a non-finite or non-positive target length, negative counts, or an option outside its
-/// range (lambda, equalize_guard_deg, boundary_spacing).
+/// range (lambda, equalize_guard_deg, boundary_spacing, feature_angle_deg).
 RemeshResult remesh(const Mesh& input, const RemeshOptions& options = {});
 
 nlohmann::json to_json(const RemeshReport& report);
