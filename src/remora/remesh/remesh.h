@@ -5,8 +5,9 @@
 // valence close to 6, and whose vertex (mixed Voronoi) areas are nearly equal, so that the
 // Laplacian of Eq. 1 becomes symmetric once every area is replaced by the mean (§5). The input is
 // never modified. Boundaries stay on the input boundary; boundary corners sharper than
-// `corner_angle_deg` stay where they are. Deterministic: the same input and options give the
-// same output, whatever the number of threads.
+// `corner_angle_deg` stay where they are; with `feature_angle_deg`, so do the input's feature
+// lines and their corners (docs/remesh.md, "Feature lines"). Deterministic: the same input and
+// options give the same output, whatever the number of threads.
 #pragma once
 
 #include <functional>
