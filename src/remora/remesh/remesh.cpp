@@ -1107,7 +1107,9 @@ private:
       const HalfedgeHandle kept = mesh_.find_halfedge(b, tips[t]);
       if (kept.is_valid()) feature(mesh_.edge_handle(kept)) = merged[t];
     }
-    if (midpoint) mesh_.set_point(b, purpose == Collapse::Repair ? relocate(b, target, b) : target);
+    // A repair comes after the last smoothing: its survivor is placed on the input at once.
+    const bool repair = purpose == Collapse::Repair || purpose == Collapse::Flat;
+    if (midpoint) mesh_.set_point(b, repair ? relocate(b, target, b) : target);
     place_points_around(b, displaced_);
     return true;
   }
@@ -1435,13 +1437,18 @@ private:
       int n = 0;
       for (auto h : mesh_.voh_range(v))
         if (feature(mesh_.edge_handle(h))) (n++ == 0 ? next : prev) = mesh_.to_vertex_handle(h);
-      if (n != 2) return false;
-      // A face (prev, v, next) would go flat on a straight line: v stays (spans_line).
+      // Where the line is not a simple path through v (a repair merged two lines), or a face
+      // (prev, v, next) would go flat on a straight line (spans_line), v stays where it is; it
+      // is still placed on its line: a split may have left it at a chord's midpoint.
+      bool stays = n != 2;
       for (auto h : mesh_.voh_range(v))
-        if (!mesh_.is_boundary(h) &&
-            spans_line(v, mesh_.to_vertex_handle(h),
-                       mesh_.to_vertex_handle(mesh_.next_halfedge_handle(h))))
-          return false;
+        stays = stays || (!mesh_.is_boundary(h) &&
+                          spans_line(v, mesh_.to_vertex_handle(h),
+                                     mesh_.to_vertex_handle(mesh_.next_halfedge_handle(h))));
+      if (stays) {
+        goal = mesh_.point(v);
+        return true;
+      }
     }
     const Vec3 mid = (mesh_.point(next) + mesh_.point(prev)) * 0.5;
     goal = mesh_.point(v) + (mid - mesh_.point(v)) * weight;
