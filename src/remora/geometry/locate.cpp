@@ -108,6 +108,36 @@ BoundaryPoint point_on_halfedge(const Mesh& mesh, HalfedgeHandle h, double t) {
   return result;
 }
 
+// The greedy descent of both walks along a chain of halfedges: from h = start, each step moves
+// to whichever of neighbours(h) (two halfedges; invalid ones are skipped) is nearest to q, if it
+// is closer than h by more than a relative 1e-12; at most max_steps moves.
+template <class Neighbours>
+BoundaryPoint descend_along(const Mesh& mesh, const Vec3& q, HalfedgeHandle start, int max_steps,
+                            Neighbours&& neighbours) {
+  const auto closest = [&mesh, &q](HalfedgeHandle h) {
+    return closest_point_on_segment(q, mesh.point(mesh.from_vertex_handle(h)),
+                                    mesh.point(mesh.to_vertex_handle(h)));
+  };
+  HalfedgeHandle h = start;
+  SegmentClosest current = closest(h);
+  for (int step = 0; step < max_steps; ++step) {
+    HalfedgeHandle best_halfedge = h;
+    SegmentClosest best = current;
+    for (const HalfedgeHandle n : neighbours(h)) {
+      if (!n.is_valid()) continue;
+      const SegmentClosest candidate = closest(n);
+      if (candidate.distance2 < best.distance2) {
+        best = candidate;
+        best_halfedge = n;
+      }
+    }
+    if (best_halfedge == h || !improves(best.distance2, current.distance2)) break;
+    h = best_halfedge;
+    current = best;
+  }
+  return point_on_halfedge(mesh, h, current.t);
+}
+
 } // namespace
 
 BoundaryPoint walk_to_closest_on_boundary(const Mesh& mesh, const Vec3& q, HalfedgeHandle start,
@@ -123,28 +153,12 @@ BoundaryPoint walk_to_closest_on_boundary(const Mesh& mesh, const Vec3& q, Halfe
                           " is not a live boundary halfedge with a face on its other side; pass "
                           "a halfedge h with mesh.is_boundary(h)");
   }
-  const auto closest = [&mesh, &q](HalfedgeHandle h) {
-    return closest_point_on_segment(q, mesh.point(mesh.from_vertex_handle(h)),
-                                    mesh.point(mesh.to_vertex_handle(h)));
-  };
-  HalfedgeHandle h = start;
-  SegmentClosest current = closest(h);
-  for (int step = 0; step < max_steps; ++step) {
-    HalfedgeHandle best_halfedge = h;
-    SegmentClosest best = current;
-    for (const HalfedgeHandle n : {mesh.next_halfedge_handle(h), mesh.prev_halfedge_handle(h)}) {
-      if (n == h || !usable(n)) continue;
-      const SegmentClosest candidate = closest(n);
-      if (candidate.distance2 < best.distance2) {
-        best = candidate;
-        best_halfedge = n;
-      }
-    }
-    if (best_halfedge == h || !improves(best.distance2, current.distance2)) break;
-    h = best_halfedge;
-    current = best;
-  }
-  return point_on_halfedge(mesh, h, current.t);
+  return descend_along(mesh, q, start, max_steps, [&](HalfedgeHandle h) {
+    std::array<HalfedgeHandle, 2> n{mesh.next_halfedge_handle(h), mesh.prev_halfedge_handle(h)};
+    for (HalfedgeHandle& g : n)
+      if (g == h || !usable(g)) g = HalfedgeHandle();
+    return n;
+  });
 }
 
 BoundaryPoint walk_to_closest_on_curve(const Mesh& mesh, const Vec3& q, HalfedgeHandle start,
@@ -173,29 +187,10 @@ BoundaryPoint walk_to_closest_on_curve(const Mesh& mesh, const Vec3& q, Halfedge
     if (count != 2) return HalfedgeHandle();
     return out ? found : mesh.opposite_halfedge_handle(found);
   };
-  const auto closest = [&mesh, &q](HalfedgeHandle h) {
-    return closest_point_on_segment(q, mesh.point(mesh.from_vertex_handle(h)),
-                                    mesh.point(mesh.to_vertex_handle(h)));
-  };
-  HalfedgeHandle h = start;
-  SegmentClosest current = closest(h);
-  for (int step = 0; step < max_steps; ++step) {
-    HalfedgeHandle best_halfedge = h;
-    SegmentClosest best = current;
-    for (const HalfedgeHandle n :
-         {other(mesh.to_vertex_handle(h), h, true), other(mesh.from_vertex_handle(h), h, false)}) {
-      if (!n.is_valid()) continue;
-      const SegmentClosest candidate = closest(n);
-      if (candidate.distance2 < best.distance2) {
-        best = candidate;
-        best_halfedge = n;
-      }
-    }
-    if (best_halfedge == h || !improves(best.distance2, current.distance2)) break;
-    h = best_halfedge;
-    current = best;
-  }
-  return point_on_halfedge(mesh, h, current.t);
+  return descend_along(mesh, q, start, max_steps, [&](HalfedgeHandle h) {
+    return std::array<HalfedgeHandle, 2>{other(mesh.to_vertex_handle(h), h, true),
+                                         other(mesh.from_vertex_handle(h), h, false)};
+  });
 }
 
 } // namespace remora

@@ -1027,8 +1027,9 @@ private:
   // Flat: a repair of a sliver between two curves (below), which may merge two of their vertices.
   enum class Collapse { Short, Repair, Boundary, Flat };
 
-  // Collapses e if the rules allow it: corners never go, an interior vertex goes onto a boundary
-  // vertex (which stays put), two boundary vertices merge along a boundary edge only, and the
+  // Collapses e if the rules allow it: corners never go, an interior vertex goes onto a curve
+  // vertex (which stays put), two curve vertices merge along a curve edge only (a Flat repair
+  // excepted: it merges them into the corner if one is, else into either), and the
   // survivor's edges stay short, the mesh stays manifold and no face turns over. Otherwise the
   // survivor moves to the midpoint: in the cycles it stays there until the smoothing projects
   // it (split_long_edges), a repair, which comes after the last smoothing, projects it at once.
@@ -1041,7 +1042,7 @@ private:
     if (ka == Kind::Corner && kb == Kind::Corner) return false;
     if (ka != Kind::Interior && kb != Kind::Interior && !on_curve(e)) {
       if (purpose != Collapse::Flat) return false;
-      if (kb != Kind::Corner) { // keep a corner where it is, else b
+      if (kb != Kind::Corner) { // keep the corner if one is
         h = mesh_.opposite_halfedge_handle(h);
         std::swap(a, b);
       }
@@ -1803,7 +1804,7 @@ private:
   const RemeshOptions& options_;
   Mesh mesh_;
   OpenMesh::VPropHandleT<SurfacePoint> loc_prop_;    // where the vertex lies on the input
-  OpenMesh::VPropHandleT<HalfedgeHandle> bloc_prop_; // boundary vertices: input boundary halfedge
+  OpenMesh::VPropHandleT<HalfedgeHandle> bloc_prop_; // curve vertices: a halfedge of the curve
   OpenMesh::VPropHandleT<Kind> kind_prop_;
   OpenMesh::EPropHandleT<char> feature_prop_; // the edge lies on a feature line of the input
   std::vector<char> input_curve_;             // per input edge: on the boundary or a feature line
