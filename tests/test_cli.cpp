@@ -214,6 +214,10 @@ TEST_F(Cli, RemeshRejectsBadOptionsBeforeWorking) {
                 .exit_code,
             2);
   EXPECT_EQ(run("remesh " + in.string() + " -o " + (dir_ / "o.xyz").string()).exit_code, 1);
+  EXPECT_EQ(
+      run("remesh " + in.string() + " -o " + (dir_ / "o.obj").string() + " --corner-angle 200")
+          .exit_code,
+      2);
   for (const auto& entry : fs::directory_iterator(dir_))
     EXPECT_EQ(entry.path().filename(), "sphere.off") << "left behind: " << entry.path();
 }

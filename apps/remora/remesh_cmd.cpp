@@ -136,6 +136,11 @@ void add_remesh_command(CLI::App& app) {
                   "cycles leave it)")
       ->check(CLI::Range(0.0, 4.0 / 3.0))
       ->capture_default_str();
+  cmd->add_option("--corner-angle", o.corner_angle_deg,
+                  "A boundary or feature-line vertex where its curve turns by more than this "
+                  "many degrees (at the scale of l) is a corner and stays")
+      ->check(CLI::Range(0.0, 180.0))
+      ->capture_default_str();
   cmd->add_option("--feature-angle", o.feature_angle_deg,
                   "Keep the input's feature lines: edges whose faces' normals differ by more than "
                   "this many degrees (0 = none)")
