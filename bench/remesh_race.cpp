@@ -265,10 +265,9 @@ void race(MeshRace& r, const Args& args) {
   remora::RemeshOptions cycles_options = eq_options;
   cycles_options.equalize_iterations = 0;
 
-  const SurfaceMesh cgal_input = to_cgal(input);
   // With --feature-angle, CGAL's own detection (the same dihedral test) marks the lines it
   // keeps; its constrained edges may still be split and collapsed along them.
-  SurfaceMesh cgal_marked = cgal_input;
+  SurfaceMesh cgal_marked = to_cgal(input);
   auto constrained =
       cgal_marked.add_property_map<SurfaceMesh::Edge_index, bool>("e:constrained", false).first;
   if (args.feature_angle > 0)

@@ -588,13 +588,10 @@ private:
       kind(v) = kinds[r];
     }
     for (std::size_t r = 0; r < nf; ++r) points(FaceHandle(static_cast<int>(r))) = lists[r];
-    if (feature_count_ > 0) {
-      std::vector<char> features(order.edges.size());
-      for (std::size_t r = 0; r < features.size(); ++r)
-        features[r] = old_features[static_cast<std::size_t>(order.edges[r])];
-      for (std::size_t r = 0; r < features.size(); ++r)
-        feature(EdgeHandle(static_cast<int>(r))) = features[r];
-    }
+    if (feature_count_ > 0)
+      for (std::size_t r = 0; r < order.edges.size(); ++r)
+        feature(EdgeHandle(static_cast<int>(r))) =
+            old_features[static_cast<std::size_t>(order.edges[r])];
     rebind_points();
     live_faces_ = mesh_.n_faces();
   }
