@@ -1412,6 +1412,21 @@ private:
       }
       return true;
     };
+    // A goal that would stretch an edge to a boundary vertex beyond the band is first pulled
+    // back into it: alternating projections onto the balls of radius √reach2 around the ring's
+    // boundary vertices, whose intersection is convex and holds p. The vertex then slides along
+    // the band's limit, centring itself between its two boundary neighbours, instead of stopping
+    // at the first edge that reaches it (halving the step, below).
+    if (r.boundary_band) {
+      const double reach = std::sqrt(reach2) * (1 - 1e-9);
+      for (int pass = 0; pass < 4; ++pass)
+        for (int j = 0; j < r.k; ++j) {
+          if (!mesh_.is_boundary(r.ring[j])) continue;
+          const Vec3& a = mesh_.point(r.ring[j]);
+          const double d = (goal - a).norm();
+          if (d > reach) goal = a + (goal - a) * (reach / d);
+        }
+    }
     const SurfacePoint before = loc(v);
     for (int tries = 0; tries < 3; ++tries, goal = (p + goal) * 0.5) {
       out = relocate(v, goal, v);
