@@ -15,6 +15,7 @@
 #include "remora/geometry/locate.h"
 #include "remora/geometry/measures.h"
 #include "remora/geometry/quality.h"
+#include "remora/mesh/build.h"
 #include "remora/mesh/io.h"
 #include "remora/mesh/primitives.h"
 #include "remora/mesh/topology.h"
@@ -217,6 +218,31 @@ TEST(Remesh, FineTuningGrowsTheBoundaryCellsWithinTheBand) {
   // ones, as they do without equalize_boundary.
   EXPECT_LE(long_boundary_edges(on.mesh, opt.target_length),
             long_boundary_edges(off.mesh, opt.target_length) + 2);
+}
+
+// Islands and holes a few target lengths around keep three corners spread around them. A
+// single triangle, a hexagon and a round 48-gon, 2.5 to 6 l around, used to be smoothed and
+// collapsed into flat or tiny triangles (a raw scan's specks: lato000.ply).
+TEST(Remesh, SmallIslandsKeepTheirArea) {
+  const std::vector<Vec3> points = {{0, 0, 0}, {1.36, 0, 0}, {0.9, 0.7, 0}};
+  const std::vector<std::array<std::uint32_t, 3>> triangles = {{0, 1, 2}};
+  const Mesh triangle = build_mesh(points, triangles);
+  for (const Mesh& input : {triangle, make_disc(1, 6, 1.0), make_disc(2, 48, 1.0)}) {
+    double perimeter = 0;
+    for (const auto& loop : boundary_loops(input))
+      for (auto h : loop) perimeter += input.calc_edge_length(h);
+    for (double around : {2.5, 3.5, 4.5, 6.0}) {
+      RemeshOptions opt;
+      opt.target_length = perimeter / around;
+      const RemeshResult r = remesh(input, opt);
+      SCOPED_TRACE(std::to_string(input.n_vertices()) + " vertices, " + std::to_string(around) +
+                   " l around");
+      expect_sound_output(r, input);
+      // Three corners a third of the way round a circle from each other span 0.41 of its area.
+      EXPECT_GT(surface_area(r.mesh), 0.4 * surface_area(input));
+      EXPECT_EQ(boundary_loops(r.mesh).size(), 1u);
+    }
+  }
 }
 
 // boundary_spacing: after the first cycle each boundary run is thinned to about 1.2 l and spaced
@@ -580,6 +606,12 @@ TEST(Remesh, RejectsBadOptions) {
   for (double angle : {-1.0, 180.0, std::nan("")}) {
     opt.feature_angle_deg = angle;
     EXPECT_THROW(remesh(input, opt), InvalidArgument) << angle;
+  }
+  opt.feature_angle_deg = 0;
+  for (double weight : {-1.0, std::nan(""), HUGE_VAL}) {
+    opt.equalize_smoothing = weight;
+    EXPECT_THROW(remesh(input, opt), InvalidArgument) << weight;
+    opt.equalize_smoothing = 1.5;
   }
   EXPECT_THROW(remesh(Mesh()), InvalidArgument);
 }
