@@ -989,11 +989,15 @@ private:
   }
 
   // Would merging a and b at p leave every edge of the survivor within √max_length2 (4/3 l in
-  // the cycles)?
+  // the cycles)? Where b stays where it is (p is b's point), only a's edges are new: b's own
+  // may be longer already (a corner of a coarse, jagged boundary) without barring the collapse.
   bool neighbours_within(VertexHandle a, VertexHandle b, const Vec3& p, double max_length2) const {
-    for (VertexHandle v : {a, b})
+    const bool b_stays = p == mesh_.point(b);
+    for (VertexHandle v : {a, b}) {
+      if (v == b && b_stays) continue;
       for (auto w : mesh_.vv_range(v))
         if (w != a && w != b && (mesh_.point(w) - p).sqrnorm() > max_length2) return false;
+    }
     return true;
   }
 
@@ -1061,7 +1065,8 @@ private:
   }
 
   // Flat: a repair of a sliver between two curves (below), which may merge two of their vertices.
-  enum class Collapse { Short, Repair, Boundary, Flat };
+  // Degenerate: a repair of a zero-area face, which may leave edges up to 8/3 l long.
+  enum class Collapse { Short, Repair, Boundary, Flat, Degenerate };
 
   // Collapses e if the rules allow it: corners never go, an interior vertex goes onto a curve
   // vertex (which stays put), two curve vertices merge along a curve edge only (a Flat repair
@@ -1095,9 +1100,11 @@ private:
     // Laplacian less than a sliver), and must raise the smallest angle around it. The length
     // test comes first: it is the cheapest and the one that fails most (two thirds of the short
     // edges of a cycle cannot go without leaving an edge longer than 4/3 l).
-    const double reach2 = purpose == Collapse::Short                                 ? hi2_
-                          : purpose == Collapse::Repair || purpose == Collapse::Flat ? 1.4 * hi2_
-                                                                                     : 4 * hi2_;
+    const bool repair =
+        purpose == Collapse::Repair || purpose == Collapse::Flat || purpose == Collapse::Degenerate;
+    const double reach2 = purpose == Collapse::Short                  ? hi2_
+                          : repair && purpose != Collapse::Degenerate ? 1.4 * hi2_
+                                                                      : 4 * hi2_;
     bool ok = neighbours_within(a, b, target, reach2);
     if (ok && !collapse_keeps_manifold(h)) {
       if (!midpoint) return false;
@@ -1107,8 +1114,7 @@ private:
       if (!ok && purpose != Collapse::Repair) return false;
     }
     ok = ok && collapse_keeps_orientation(h, target) &&
-         ((purpose != Collapse::Repair && purpose != Collapse::Flat) ||
-          collapse_raises_min_angle(h, target));
+         (!repair || collapse_raises_min_angle(h, target));
     if (!ok) {
       // A repair of an interior edge may also collapse it into either endpoint, which stays
       // where it is, on the input: on a crease (gears.stl at 0.6 l) the midpoint can be the
@@ -1145,7 +1151,6 @@ private:
       if (kept.is_valid()) feature(mesh_.edge_handle(kept)) = merged[t];
     }
     // A repair comes after the last smoothing: its survivor is placed on the input at once.
-    const bool repair = purpose == Collapse::Repair || purpose == Collapse::Flat;
     if (midpoint) mesh_.set_point(b, repair ? relocate(b, target, b) : target);
     place_points_around(b, displaced_);
     return true;
@@ -1176,6 +1181,25 @@ private:
     mesh_.garbage_collection();
     rebind_points();
     live_faces_ = mesh_.n_faces();
+  }
+
+  // Flips e where the rules allow it (not on a curve, a manifold result, both new faces facing
+  // the old pair's way) and the smaller angle of its two faces grows.
+  bool try_repair_flip(EdgeHandle e) {
+    if (on_curve(e) || !mesh_.is_flip_ok(e)) return false;
+    const HalfedgeHandle h0 = mesh_.halfedge_handle(e, 0), h1 = mesh_.halfedge_handle(e, 1);
+    const VertexHandle a = mesh_.to_vertex_handle(h0), b = mesh_.to_vertex_handle(h1);
+    const VertexHandle c = mesh_.to_vertex_handle(mesh_.next_halfedge_handle(h0));
+    const VertexHandle d = mesh_.to_vertex_handle(mesh_.next_halfedge_handle(h1));
+    auto min_angle = [&](VertexHandle x, VertexHandle y, VertexHandle z) {
+      const auto t = triangle_angles(mesh_.point(x), mesh_.point(y), mesh_.point(z));
+      return std::min({t[0], t[1], t[2]});
+    };
+    const double before = std::min(min_angle(b, a, c), min_angle(a, b, d));
+    const double after = std::min(min_angle(a, c, d), min_angle(c, b, d));
+    if (!(after > before) || !flip_keeps_orientation(a, b, c, d)) return false;
+    mesh_.flip(e);
+    return true;
   }
 
   // One sweep of repair_bad_triangles().
@@ -1214,29 +1238,28 @@ private:
       if (min_angle(fv[0], fv[1], fv[2]) >= min_rad) continue;
       const int longest = static_cast<int>(std::max_element(len, len + 3) - len);
       const EdgeHandle el = mesh_.edge_handle(hs[longest]);
-      if (!on_curve(el) && mesh_.is_flip_ok(el)) {
-        const HalfedgeHandle h0 = mesh_.halfedge_handle(el, 0), h1 = mesh_.halfedge_handle(el, 1);
-        const VertexHandle a = mesh_.to_vertex_handle(h0), b = mesh_.to_vertex_handle(h1);
-        const VertexHandle c = mesh_.to_vertex_handle(mesh_.next_halfedge_handle(h0));
-        const VertexHandle d = mesh_.to_vertex_handle(mesh_.next_halfedge_handle(h1));
-        const double before = std::min(min_angle(b, a, c), min_angle(a, b, d));
-        const double after = std::min(min_angle(a, c, d), min_angle(c, b, d));
-        if (after > before && flip_keeps_orientation(a, b, c, d)) {
-          mesh_.flip(el);
-          ++count;
-          continue;
-        }
+      if (try_repair_flip(el)) {
+        ++count;
+        continue;
       }
       if (try_collapse(mesh_.edge_handle(hs[shortest]), Collapse::Repair)) {
         ++count;
         continue;
       }
       // A flat face (three corners on a line, as on a sharp crease) is worth any collapse of
-      // its edges that the rules allow, the other two included.
+      // its edges that the rules allow, the other two included; last, one that may leave edges
+      // up to 8/3 l. A face across a crack of the input (two boundary vertices on one side, one
+      // on the other, all on the crack's line, next to its tip) had no other way out: there a
+      // curve vertex goes into the tip.
       if (face_cross(f).norm() <= 1e-6 * length_ * length_) {
         bool done = false;
         for (int k : {(shortest + 1) % 3, (shortest + 2) % 3})
           if (!done && try_collapse(mesh_.edge_handle(hs[k]), Collapse::Repair)) {
+            ++count;
+            done = true;
+          }
+        for (int k = 0; k < 3 && !done; ++k)
+          if (try_collapse(mesh_.edge_handle(hs[k]), Collapse::Degenerate)) {
             ++count;
             done = true;
           }
@@ -1353,9 +1376,42 @@ private:
     move_vertices_placing([&](VertexHandle v, Vec3& out) {
       Vec3 g;
       if (!target(v, g)) return Placed::No;
+      if (kind(v) != Kind::Curve) {
+        out = relocate(v, g, v);
+        return Placed::Moved;
+      }
+      // A curve vertex slides along its curve, which may run back along itself: the two sides
+      // of a crack in the input, which meet at a pinched vertex the loader split. Slid onto
+      // the other side, its faces spanned the crack and went flat (randomly thinned grids: 15
+      // of 300 had flat output faces). It stays where a face of its ring would go flat or turn
+      // over; placed on its curve there (a split or a collapse may have left it at a chord's
+      // midpoint, for the smoothing to place).
+      const SurfacePoint before = loc(v);
+      const HalfedgeHandle before_curve = bloc(v);
       out = relocate(v, g, v);
+      if (ring_keeps_faces(v, out)) return Placed::Moved;
+      loc(v) = before;
+      bloc(v) = before_curve;
+      out = relocate(v, mesh_.point(v), v);
       return Placed::Moved;
     });
+  }
+
+  // Would moving v to q keep each face around it from going flat or turning over (against its
+  // normal now, where it has one)?
+  bool ring_keeps_faces(VertexHandle v, const Vec3& q) const {
+    const Vec3 p = mesh_.point(v);
+    const double tiny = 1e-12 * hi2_;
+    for (auto h : mesh_.voh_range(v)) {
+      if (mesh_.is_boundary(h)) continue;
+      const Vec3& a = mesh_.point(mesh_.to_vertex_handle(h));
+      const Vec3& b = mesh_.point(mesh_.to_vertex_handle(mesh_.next_halfedge_handle(h)));
+      const Vec3 n_new = OpenMesh::cross(a - q, b - q);
+      if (n_new.norm() <= tiny) return false;
+      const Vec3 n_old = OpenMesh::cross(a - p, b - p);
+      if (n_old.norm() > tiny && !(OpenMesh::dot(n_new, n_old) > 0)) return false;
+    }
+    return true;
   }
 
   // What a placing target did with its vertex.
