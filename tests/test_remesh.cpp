@@ -652,6 +652,10 @@ TEST(Remesh, RejectsBadOptions) {
     EXPECT_THROW(remesh(input, opt), InvalidArgument) << weight;
     opt.equalize_smoothing = 1.5;
   }
+  for (double angle : {-1.0, 181.0, std::nan("")}) {
+    opt.corner_angle_deg = angle;
+    EXPECT_THROW(remesh(input, opt), InvalidArgument) << angle;
+  }
   EXPECT_THROW(remesh(Mesh()), InvalidArgument);
 }
 

@@ -1102,9 +1102,9 @@ private:
     // edges of a cycle cannot go without leaving an edge longer than 4/3 l).
     const bool repair =
         purpose == Collapse::Repair || purpose == Collapse::Flat || purpose == Collapse::Degenerate;
-    const double reach2 = purpose == Collapse::Short                  ? hi2_
-                          : repair && purpose != Collapse::Degenerate ? 1.4 * hi2_
-                                                                      : 4 * hi2_;
+    const double reach2 = purpose == Collapse::Short                                 ? hi2_
+                          : purpose == Collapse::Repair || purpose == Collapse::Flat ? 1.4 * hi2_
+                                                                                     : 4 * hi2_;
     bool ok = neighbours_within(a, b, target, reach2);
     if (ok && !collapse_keeps_manifold(h)) {
       if (!midpoint) return false;
@@ -1183,6 +1183,12 @@ private:
     live_faces_ = mesh_.n_faces();
   }
 
+  // The smallest angle (radians) of the triangle (x, y, z) at the current positions.
+  double min_angle(VertexHandle x, VertexHandle y, VertexHandle z) const {
+    const auto a = triangle_angles(mesh_.point(x), mesh_.point(y), mesh_.point(z));
+    return std::min({a[0], a[1], a[2]});
+  }
+
   // Flips e where the rules allow it (not on a curve, a manifold result, both new faces facing
   // the old pair's way) and the smaller angle of its two faces grows.
   bool try_repair_flip(EdgeHandle e) {
@@ -1191,10 +1197,6 @@ private:
     const VertexHandle a = mesh_.to_vertex_handle(h0), b = mesh_.to_vertex_handle(h1);
     const VertexHandle c = mesh_.to_vertex_handle(mesh_.next_halfedge_handle(h0));
     const VertexHandle d = mesh_.to_vertex_handle(mesh_.next_halfedge_handle(h1));
-    auto min_angle = [&](VertexHandle x, VertexHandle y, VertexHandle z) {
-      const auto t = triangle_angles(mesh_.point(x), mesh_.point(y), mesh_.point(z));
-      return std::min({t[0], t[1], t[2]});
-    };
     const double before = std::min(min_angle(b, a, c), min_angle(a, b, d));
     const double after = std::min(min_angle(a, c, d), min_angle(c, b, d));
     if (!(after > before) || !flip_keeps_orientation(a, b, c, d)) return false;
@@ -1207,10 +1209,6 @@ private:
     const double min_rad = min_deg * M_PI / 180.0;
     const double cos_min = std::cos(min_rad);
     std::size_t count = 0;
-    auto min_angle = [&](VertexHandle x, VertexHandle y, VertexHandle z) {
-      const auto a = triangle_angles(mesh_.point(x), mesh_.point(y), mesh_.point(z));
-      return std::min({a[0], a[1], a[2]});
-    };
     const std::size_t n = mesh_.n_faces();
     for (std::size_t i = 0; i < n; ++i) {
       const FaceHandle f(static_cast<int>(i));
@@ -1963,6 +1961,8 @@ RemeshResult remesh(const Mesh& input, const RemeshOptions& options) {
     throw InvalidArgument("remesh: lambda must be in (0, 1]");
   if (!(options.equalize_smoothing >= 0 && std::isfinite(options.equalize_smoothing)))
     throw InvalidArgument("remesh: equalize_smoothing must be finite and >= 0");
+  if (!(options.corner_angle_deg >= 0 && options.corner_angle_deg <= 180))
+    throw InvalidArgument("remesh: corner_angle_deg must be in [0, 180] degrees");
   if (!(options.equalize_guard_deg >= 0 && options.equalize_guard_deg < 60))
     throw InvalidArgument("remesh: equalize_guard_deg must be in [0, 60) degrees (0 = off)");
   if (!(options.feature_angle_deg >= 0 && options.feature_angle_deg < 180))

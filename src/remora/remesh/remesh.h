@@ -141,7 +141,8 @@ struct RemeshResult {
 
 /// Remeshes `input` (a repaired, manifold triangle mesh). Throws InvalidArgument for an empty
 /// mesh, a non-finite or non-positive target length, negative counts, or an option outside its
-/// range (lambda, equalize_guard_deg, boundary_spacing, feature_angle_deg).
+/// range (lambda, equalize_smoothing, equalize_guard_deg, corner_angle_deg, boundary_spacing,
+/// feature_angle_deg).
 RemeshResult remesh(const Mesh& input, const RemeshOptions& options = {});
 
 nlohmann::json to_json(const RemeshReport& report);
