@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <unordered_set>
 
 #include <Eigen/Dense>
 #include <nlohmann/json.hpp>
@@ -1071,8 +1072,9 @@ private:
   // Collapses e if the rules allow it: corners never go, an interior vertex goes onto a curve
   // vertex (which stays put), two curve vertices merge along a curve edge only (a Flat repair
   // excepted: it merges them into the corner if one is, else into either), and the
-  // survivor's edges stay short, the mesh stays manifold and no face turns over. Otherwise the
-  // survivor moves to the midpoint: in the cycles it stays there until the smoothing projects
+  // survivor's edges stay short, the mesh stays manifold and no face turns over (two vertices at
+  // one point need only the kinds and the manifold rule). Otherwise the survivor moves to the
+  // midpoint: in the cycles it stays there until the smoothing projects
   // it (split_long_edges), a repair, which comes after the last smoothing, projects it at once.
   bool try_collapse(EdgeHandle e, Collapse purpose) {
     HalfedgeHandle h = mesh_.halfedge_handle(e, 0);
@@ -1096,6 +1098,55 @@ private:
       midpoint = false; // remove a, keep b where it is
     }
     Vec3 target = midpoint ? (mesh_.point(a) + mesh_.point(b)) * 0.5 : mesh_.point(b);
+    const bool repair =
+        purpose == Collapse::Repair || purpose == Collapse::Flat || purpose == Collapse::Degenerate;
+    if ((mesh_.point(a) - mesh_.point(b)).sqrnorm() <= 1e-12 * hi2_) {
+      // Two vertices at one point (the smoothing, moving all vertices at once, placed both on
+      // the same input vertex or crack tip): merging them changes no remaining face, it only
+      // removes the two flat ones; so only the kinds (above) and the manifold rule hold here.
+      // Otherwise a cluster of such vertices never went: each collapse left a flat face.
+      if (!collapse_keeps_manifold(h)) {
+        if (!midpoint) return false;
+        h = mesh_.opposite_halfedge_handle(h);
+        std::swap(a, b);
+        if (!collapse_keeps_manifold(h)) return false;
+      }
+      target = mesh_.point(b);
+      midpoint = false;
+    } else if (!collapse_allowed(purpose, h, a, b, target, midpoint)) {
+      return false;
+    }
+    live_faces_ -= mesh_.is_boundary(e) ? 1 : 2;
+    // The two faces of the edge go: their input vertices move to the survivor's faces. In each,
+    // the edges from a and b to the tip merge; the merged edge is a feature if either was.
+    VertexHandle tips[2];
+    char merged[2] = {0, 0};
+    int n_tips = 0;
+    for (auto side : {h, mesh_.opposite_halfedge_handle(h)}) {
+      if (mesh_.is_boundary(side)) continue;
+      take_points(mesh_.face_handle(side), displaced_);
+      if (feature_count_ == 0) continue;
+      const HalfedgeHandle n1 = mesh_.next_halfedge_handle(side);
+      tips[n_tips] = mesh_.to_vertex_handle(n1);
+      merged[n_tips++] = feature(mesh_.edge_handle(n1)) ||
+                         feature(mesh_.edge_handle(mesh_.next_halfedge_handle(n1)));
+    }
+    mesh_.collapse(h);
+    for (int t = 0; t < n_tips; ++t) {
+      const HalfedgeHandle kept = mesh_.find_halfedge(b, tips[t]);
+      if (kept.is_valid()) feature(mesh_.edge_handle(kept)) = merged[t];
+    }
+    // A repair comes after the last smoothing: its survivor is placed on the input at once.
+    if (midpoint) mesh_.set_point(b, repair ? relocate(b, target, b) : target);
+    place_points_around(b, displaced_);
+    return true;
+  }
+
+  // The geometric rules of try_collapse() for collapsing h (a into b) with the survivor at
+  // `target`: where the first choice fails, a collapse the other way (and for a repair into
+  // either endpoint) may be taken instead, which updates h, a, b, target and midpoint.
+  bool collapse_allowed(Collapse purpose, HalfedgeHandle& h, VertexHandle& a, VertexHandle& b,
+                        Vec3& target, bool& midpoint) const {
     // A repair may leave an edge up to √1.4 × 4/3 l ≈ 1.58 l long (one long edge costs the
     // Laplacian less than a sliver), and must raise the smallest angle around it. The length
     // test comes first: it is the cheapest and the one that fails most (two thirds of the short
@@ -1130,29 +1181,6 @@ private:
       }
       if (!ok) return false;
     }
-    live_faces_ -= mesh_.is_boundary(e) ? 1 : 2;
-    // The two faces of the edge go: their input vertices move to the survivor's faces. In each,
-    // the edges from a and b to the tip merge; the merged edge is a feature if either was.
-    VertexHandle tips[2];
-    char merged[2] = {0, 0};
-    int n_tips = 0;
-    for (auto side : {h, mesh_.opposite_halfedge_handle(h)}) {
-      if (mesh_.is_boundary(side)) continue;
-      take_points(mesh_.face_handle(side), displaced_);
-      if (feature_count_ == 0) continue;
-      const HalfedgeHandle n1 = mesh_.next_halfedge_handle(side);
-      tips[n_tips] = mesh_.to_vertex_handle(n1);
-      merged[n_tips++] = feature(mesh_.edge_handle(n1)) ||
-                         feature(mesh_.edge_handle(mesh_.next_halfedge_handle(n1)));
-    }
-    mesh_.collapse(h);
-    for (int t = 0; t < n_tips; ++t) {
-      const HalfedgeHandle kept = mesh_.find_halfedge(b, tips[t]);
-      if (kept.is_valid()) feature(mesh_.edge_handle(kept)) = merged[t];
-    }
-    // A repair comes after the last smoothing: its survivor is placed on the input at once.
-    if (midpoint) mesh_.set_point(b, repair ? relocate(b, target, b) : target);
-    place_points_around(b, displaced_);
     return true;
   }
 
@@ -1204,6 +1232,80 @@ private:
     return true;
   }
 
+  // Moves interior vertex v to its one-ring centroid (the move in its tangent plane, then onto
+  // the input) where no face of its ring goes flat or turns over and the ring's smallest angle
+  // grows. The repair of a flat face that no flip or collapse mends: an interior vertex that the
+  // smoothing left on a boundary edge of the input, in line with two boundary vertices (blade.off
+  // at 10 cycles, where the blade's rim curls up from the plate: the goal's closest point lies
+  // on the plate, but relocate()'s walk from the rim stops on the rim).
+  bool try_repair_move(VertexHandle v) {
+    if (kind(v) != Kind::Interior || mesh_.is_boundary(v)) return false;
+    Vec3 centroid(0, 0, 0);
+    int k = 0;
+    for (auto w : mesh_.vv_range(v)) {
+      centroid += mesh_.point(w);
+      ++k;
+    }
+    if (k < 3) return false;
+    const Vec3 p = mesh_.point(v);
+    Vec3 u = centroid / k - p;
+    const Vec3 n = vertex_normal(v);
+    u -= n * OpenMesh::dot(n, u);
+    const SurfacePoint there = closest_around(p + u, p, loc(v).face, 2 * length_);
+    const Vec3 q = options_.project ? evaluate(input_, there) : p + u;
+    if (!ring_keeps_faces(v, q) || !(ring_min_angle(v, q) > ring_min_angle(v, p))) return false;
+    loc(v) = there;
+    mesh_.set_point(v, q);
+    return true;
+  }
+
+  // The closest point to q on the input faces within `radius` of `from` (a point on face
+  // `start`): a breadth-first search across the input's edges, at most 4096 faces. Unlike
+  // relocate()'s walks it finds the closest point where the surface curls back between `from`
+  // and q; the repairs' rare moves can pay for it.
+  SurfacePoint closest_around(const Vec3& q, const Vec3& from, FaceHandle start,
+                              double radius) const {
+    const double radius2 = radius * radius;
+    std::vector<FaceHandle> queue{start};
+    std::unordered_set<int> seen{start.idx()};
+    SurfacePoint best;
+    double best_d2 = std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < queue.size() && queue.size() < 4096; ++i) {
+      const FaceHandle f = queue[i];
+      const auto fv = face_vertices(input_, f);
+      const Vec3 &a = input_.point(fv[0]), &b = input_.point(fv[1]), &c = input_.point(fv[2]);
+      const TriangleClosest to_q = closest_point_on_triangle(q, a, b, c);
+      if (to_q.distance2 < best_d2) {
+        best_d2 = to_q.distance2;
+        best = SurfacePoint{f, to_q.bary};
+      }
+      for (auto h : input_.fh_range(f)) {
+        const FaceHandle g = input_.opposite_face_handle(h);
+        if (!g.is_valid() || seen.count(g.idx())) continue;
+        seen.insert(g.idx());
+        const auto gv = face_vertices(input_, g);
+        if (closest_point_on_triangle(from, input_.point(gv[0]), input_.point(gv[1]),
+                                      input_.point(gv[2]))
+                .distance2 <= radius2)
+          queue.push_back(g);
+      }
+    }
+    return best;
+  }
+
+  // The smallest angle (radians) of the faces around v, with v at q.
+  double ring_min_angle(VertexHandle v, const Vec3& q) const {
+    double smallest = M_PI;
+    for (auto h : mesh_.voh_range(v)) {
+      if (mesh_.is_boundary(h)) continue;
+      const Vec3& a = mesh_.point(mesh_.to_vertex_handle(h));
+      const Vec3& b = mesh_.point(mesh_.to_vertex_handle(mesh_.next_halfedge_handle(h)));
+      const auto t = triangle_angles(q, a, b);
+      smallest = std::min({smallest, t[0], t[1], t[2]});
+    }
+    return smallest;
+  }
+
   // One sweep of repair_bad_triangles().
   std::size_t repair_pass(double min_deg) {
     const double min_rad = min_deg * M_PI / 180.0;
@@ -1253,6 +1355,11 @@ private:
         bool done = false;
         for (int k : {(shortest + 1) % 3, (shortest + 2) % 3})
           if (!done && try_collapse(mesh_.edge_handle(hs[k]), Collapse::Repair)) {
+            ++count;
+            done = true;
+          }
+        for (int k = 0; k < 3 && !done; ++k)
+          if (try_repair_move(fv[k])) {
             ++count;
             done = true;
           }
