@@ -411,22 +411,23 @@ private:
 
   // Marks as corners the vertices of `vs` (a curve of the input, closed or open) where it turns
   // sharply at the scale of the target length: the turn at v is measured between the chords to
-  // the curve's points about l/2 before and after it, so that the zigzag of a scanned hole
-  // (sharp at the scale of its own edges) is not a corner while a CAD corner is; of the vertices
-  // around one corner only the sharpest is kept, and none within l/2 of a vertex where feature
-  // lines end or meet (which is a corner already: blade.off has a boundary turn 0.03 l from
-  // where a feature line meets the boundary, and the edge between two corners cannot go).
+  // the curve's points about l/2 before and after it, and again 2 l before and after it; a corner
+  // turns sharply at both scales. So the zigzag of a scanned hole (sharp at the scale of its own
+  // edges, or of l/2: the raw bunny's rims had 82 corners, 39 now) is not a corner while a CAD
+  // corner is. Of the vertices around one corner only the sharpest is kept, and none within l/2
+  // of a vertex where feature lines end or meet (which is a corner already: blade.off has a
+  // boundary turn 0.03 l from where a feature line meets the boundary, and the edge between two
+  // corners cannot go).
   void mark_turns(const std::vector<VertexHandle>& vs, bool closed, double corner_cos) {
-    const double reach2 = 0.25 * length_ * length_;
     const std::size_t n = vs.size();
     if (n < 3) return;
-    std::vector<double> turn(n, 1.0); // cosine of the turning angle; lower is sharper
-    std::vector<std::size_t> before(n), after(n);
-    for (std::size_t i = 0; i < n; ++i) {
-      before[i] = after[i] = i;
-      if (!closed && (i == 0 || i + 1 == n)) continue;
+    // The cosine of the turn at vs[i] between the chords to the curve's points at least `reach`
+    // away before and after it; b and a receive their indices.
+    auto turn_at = [&](std::size_t i, double reach, std::size_t& b, std::size_t& a) {
+      const double reach2 = reach * reach;
       const Vec3 p = input_.point(vs[i]);
-      std::size_t b = (i + n - 1) % n, a = (i + 1) % n;
+      b = (i + n - 1) % n;
+      a = (i + 1) % n;
       if (closed) {
         while (b != a && (input_.point(vs[b]) - p).sqrnorm() < reach2) b = (b + n - 1) % n;
         while (a != b && (input_.point(vs[a]) - p).sqrnorm() < reach2) a = (a + 1) % n;
@@ -434,11 +435,18 @@ private:
         while (b > 0 && (input_.point(vs[b]) - p).sqrnorm() < reach2) --b;
         while (a + 1 < n && (input_.point(vs[a]) - p).sqrnorm() < reach2) ++a;
       }
-      before[i] = b;
-      after[i] = a;
       const Vec3 d_in = p - input_.point(vs[b]), d_out = input_.point(vs[a]) - p;
       const double len = d_in.norm() * d_out.norm();
-      turn[i] = len > 0 ? OpenMesh::dot(d_in, d_out) / len : 1.0;
+      return len > 0 ? OpenMesh::dot(d_in, d_out) / len : 1.0;
+    };
+    std::vector<double> turn(n, 1.0); // cosine of the turning angle; lower is sharper
+    std::vector<std::size_t> before(n), after(n);
+    for (std::size_t i = 0; i < n; ++i) {
+      before[i] = after[i] = i;
+      if (!closed && (i == 0 || i + 1 == n)) continue;
+      turn[i] = turn_at(i, 0.5 * length_, before[i], after[i]);
+      std::size_t b = 0, a = 0;
+      if (turn[i] < corner_cos && turn_at(i, 2 * length_, b, a) >= corner_cos) turn[i] = 1.0;
     }
     for (std::size_t i = 0; i < n; ++i) {
       if (turn[i] >= corner_cos) continue;
