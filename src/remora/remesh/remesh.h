@@ -72,7 +72,8 @@ struct RemeshOptions {
   /// longest edge flipped or shortest edge collapsed where the rules allow.
   double repair_angle_deg = 25.0;
   /// A curve vertex (boundary or feature line) where its curve turns by more than this, at the
-  /// scale of l, is a corner and never moves.
+  /// scale of l (between the chords to its curve's points l/2 away, and again 2 l away: a
+  /// scanned rim's zigzag is no corner), is a corner and never moves.
   double corner_angle_deg = 30.0;
   /// Input edges whose faces' normals differ by more than this many degrees are features
   /// (feature_edges() in geometry/measures.h): like the boundary, their lines are kept. Output
