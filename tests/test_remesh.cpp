@@ -281,28 +281,32 @@ TEST(Remesh, SmallIslandsKeepTheirArea) {
   }
 }
 
-// Random thinnings of a wavy grid: islands, strips one triangle wide, holes, and cracks whose two
-// sides meet at vertices the loader splits (pinches). A boundary vertex sliding along such a
-// crack used to reach its other side, and the faces between the two sides went flat (15 of 300
-// thinnings). Every output is sound: no flat face, every location on its point.
-TEST(Remesh, ThinnedGridsWithCracksGiveNoFlatFaces) {
-  std::uint64_t state = 12345;
-  auto next = [&state] { // a portable linear congruential generator, in [0, 1)
+// A portable linear congruential generator, in [0, 1): the fuzz tests below draw the same
+// meshes on every platform.
+struct Lcg {
+  std::uint64_t state;
+  double operator()() {
     state = state * 6364136223846793005ULL + 1442695040888963407ULL;
     return static_cast<double>(state >> 11) / 9007199254740992.0;
-  };
-  for (int trial = 0; trial < 60; ++trial) {
-    const int n = 6 + trial % 15;
-    const Mesh grid = make_grid(n, n, 1.0, 1.0);
+  }
+};
+
+// Remeshes `trials` random thinnings and checks every output: no flat face, every location on
+// its point. Trial t thins make(t) = {mesh, cells across}, its points moved by move(p) (drawn
+// first), each face kept with probability keep_min + (1 - keep_min) × a draw, after the
+// loader's repair (islands, strips, holes, and cracks whose pinches it splits); the target
+// length is (0.3 + length_span × a draw) / cells, and every features_every-th trial keeps
+// feature lines at 30 degrees.
+template <class Make, class Move>
+void expect_sound_thinnings(Lcg& next, int trials, Make make, Move move, double keep_min,
+                            double length_span, int features_every) {
+  for (int trial = 0; trial < trials; ++trial) {
+    const auto [base, cells] = make(trial);
     PolygonSoup soup;
-    for (auto v : grid.vertices()) {
-      Vec3 p = grid.point(v);
-      p[2] = 0.1 * std::sin(7 * p[0]) * std::cos(5 * p[1]) + 0.02 * next();
-      soup.points.push_back(p);
-    }
-    const double keep = 0.3 + 0.7 * next();
-    for (auto f : grid.faces()) {
-      const auto fv = face_vertices(grid, f);
+    for (auto v : base.vertices()) soup.points.push_back(move(base.point(v)));
+    const double keep = keep_min + (1 - keep_min) * next();
+    for (auto f : base.faces()) {
+      const auto fv = face_vertices(base, f);
       if (next() < keep)
         soup.add_triangle(static_cast<std::uint32_t>(fv[0].idx()),
                           static_cast<std::uint32_t>(fv[1].idx()),
@@ -310,12 +314,31 @@ TEST(Remesh, ThinnedGridsWithCracksGiveNoFlatFaces) {
     }
     const Mesh input = repair_soup(soup).mesh;
     RemeshOptions opt;
-    opt.target_length = (0.3 + 3 * next()) / n;
-    opt.feature_angle_deg = trial % 3 == 0 ? 30 : 0;
+    opt.target_length = (0.3 + length_span * next()) / cells;
+    opt.feature_angle_deg = trial % features_every == 0 ? 30 : 0;
     if (input.n_faces() == 0) continue;
     SCOPED_TRACE("trial " + std::to_string(trial));
     expect_sound_output(remesh(input, opt), input);
   }
+}
+
+// Random thinnings of a wavy grid: islands, strips one triangle wide, holes, and cracks whose two
+// sides meet at vertices the loader splits (pinches). A boundary vertex sliding along such a
+// crack used to reach its other side, and the faces between the two sides went flat (15 of 300
+// thinnings). Every output is sound: no flat face, every location on its point.
+TEST(Remesh, ThinnedGridsWithCracksGiveNoFlatFaces) {
+  Lcg next{12345};
+  expect_sound_thinnings(
+      next, 60,
+      [](int trial) {
+        const int n = 6 + trial % 15;
+        return std::pair{make_grid(n, n, 1.0, 1.0), n};
+      },
+      [&next](Vec3 p) {
+        p[2] = 0.1 * std::sin(7 * p[0]) * std::cos(5 * p[1]) + 0.02 * next();
+        return p;
+      },
+      0.3, 3.0, 3);
 }
 
 // Noisy cubes with random faces removed: cracks, pinches split by the loader, feature lines on
@@ -323,36 +346,18 @@ TEST(Remesh, ThinnedGridsWithCracksGiveNoFlatFaces) {
 // input vertex or crack tip; each collapse of such a cluster used to leave a flat face behind
 // and so was refused (32 of 6,000 such cubes kept flat faces; the first 150 below, 3).
 TEST(Remesh, ThinnedCubesGiveNoFlatFaces) {
-  std::uint64_t state = 22;
-  auto next = [&state] { // a portable linear congruential generator, in [0, 1)
-    state = state * 6364136223846793005ULL + 1442695040888963407ULL;
-    return static_cast<double>(state >> 11) / 9007199254740992.0;
-  };
-  for (int trial = 0; trial < 150; ++trial) {
-    const int n = 3 + trial % 5;
-    const Mesh cube = make_cube(n, 1.0);
-    PolygonSoup soup;
-    for (auto v : cube.vertices()) {
-      Vec3 p = cube.point(v);
-      for (int k = 0; k < 3; ++k) p[k] += 0.003 * (next() - 0.5);
-      soup.points.push_back(p);
-    }
-    const double keep = 0.4 + 0.6 * next();
-    for (auto f : cube.faces()) {
-      const auto fv = face_vertices(cube, f);
-      if (next() < keep)
-        soup.add_triangle(static_cast<std::uint32_t>(fv[0].idx()),
-                          static_cast<std::uint32_t>(fv[1].idx()),
-                          static_cast<std::uint32_t>(fv[2].idx()));
-    }
-    const Mesh input = repair_soup(soup).mesh;
-    RemeshOptions opt;
-    opt.target_length = (0.3 + 2.5 * next()) / n;
-    opt.feature_angle_deg = trial % 2 == 0 ? 30 : 0;
-    if (input.n_faces() == 0) continue;
-    SCOPED_TRACE("trial " + std::to_string(trial));
-    expect_sound_output(remesh(input, opt), input);
-  }
+  Lcg next{22};
+  expect_sound_thinnings(
+      next, 150,
+      [](int trial) {
+        const int n = 3 + trial % 5;
+        return std::pair{make_cube(n, 1.0), n};
+      },
+      [&next](Vec3 p) {
+        for (int k = 0; k < 3; ++k) p[k] += 0.003 * (next() - 0.5);
+        return p;
+      },
+      0.4, 2.5, 2);
 }
 
 // boundary_spacing: after the first cycle each boundary run is thinned to about 1.2 l and spaced
