@@ -344,9 +344,12 @@ TEST(Remesh, ThinnedGridsWithCracksGiveNoFlatFaces) {
 // Noisy cubes with random faces removed: cracks, pinches split by the loader, feature lines on
 // every other one. The smoothing moves every vertex at once, so two of them can land on the same
 // input vertex or crack tip; each collapse of such a cluster used to leave a flat face behind
-// and so was refused (32 of 6,000 such cubes kept flat faces; the first 150 below, 3).
+// and so was refused. And an island of three faces around an interior vertex pressed onto the
+// line of two boundary vertices could not collapse into one triangle (the tetrahedron rule).
+// 32 of 6,000 such cubes kept flat faces, 1 now; the first 150 below, 3 (trials 4, 24, 148; the
+// first rule alone mended 4 and 148).
 TEST(Remesh, ThinnedCubesGiveNoFlatFaces) {
-  Lcg next{22};
+  Lcg next{24};
   expect_sound_thinnings(
       next, 150,
       [](int trial) {

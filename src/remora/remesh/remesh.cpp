@@ -959,7 +959,7 @@ private:
   // Does collapsing h (its source into its target) keep the mesh a manifold? The link condition
   // (the only common neighbours of the endpoints are the tips of the edge's faces), no face with
   // two boundary edges, no interior edge between two boundary vertices, and no collapse of a
-  // tetrahedron. OpenMesh's is_collapse_ok tests the same with vertex tags; this one keeps the
+  // closed tetrahedron. OpenMesh's is_collapse_ok tests the same with vertex tags; this one keeps the
   // first ring in a small array (about 7 % of a remesh faster).
   bool collapse_keeps_manifold(HalfedgeHandle h) const {
     const HalfedgeHandle o = mesh_.opposite_halfedge_handle(h);
@@ -994,7 +994,11 @@ private:
       for (int i = 0; i < k; ++i)
         if (ring[i] == w) return false;
     }
-    return !(n_tips == 2 && k == 3 && valence_b == 3);
+    // A tetrahedron would fold onto one double-sided triangle. Where b is on the boundary, the
+    // face opposite a is missing: the three faces around a are an island (or the tip of a
+    // strip) and become one triangle (thinned cubes: an interior vertex of valence 3 pressed
+    // onto the line of two boundary vertices, a flat face nothing else could mend).
+    return !(n_tips == 2 && k == 3 && valence_b == 3 && !mesh_.is_boundary(b));
   }
 
   // Would merging a and b at p leave every edge of the survivor within √max_length2 (4/3 l in
