@@ -1080,6 +1080,10 @@ private:
   // Flat: a repair of a sliver between two curves (below), which may merge two of their vertices.
   // Degenerate: a repair of a zero-area face, which may leave edges up to 8/3 l long.
   enum class Collapse { Short, Repair, Boundary, Flat, Degenerate };
+  static bool is_repair(Collapse purpose) {
+    return purpose == Collapse::Repair || purpose == Collapse::Flat ||
+           purpose == Collapse::Degenerate;
+  }
 
   // Collapses e if the rules allow it: corners never go, an interior vertex goes onto a curve
   // vertex (which stays put), two curve vertices merge along a curve edge only (a Flat repair
@@ -1110,24 +1114,7 @@ private:
       midpoint = false; // remove a, keep b where it is
     }
     Vec3 target = midpoint ? (mesh_.point(a) + mesh_.point(b)) * 0.5 : mesh_.point(b);
-    const bool repair =
-        purpose == Collapse::Repair || purpose == Collapse::Flat || purpose == Collapse::Degenerate;
-    if ((mesh_.point(a) - mesh_.point(b)).sqrnorm() <= 1e-12 * hi2_) {
-      // Two vertices at one point (the smoothing, moving all vertices at once, placed both on
-      // the same input vertex or crack tip): merging them changes no remaining face, it only
-      // removes the two flat ones; so only the kinds (above) and the manifold rule hold here.
-      // Otherwise a cluster of such vertices never went: each collapse left a flat face.
-      if (!collapse_keeps_manifold(h)) {
-        if (!midpoint) return false;
-        h = mesh_.opposite_halfedge_handle(h);
-        std::swap(a, b);
-        if (!collapse_keeps_manifold(h)) return false;
-      }
-      target = mesh_.point(b);
-      midpoint = false;
-    } else if (!collapse_allowed(purpose, h, a, b, target, midpoint)) {
-      return false;
-    }
+    if (!collapse_allowed(purpose, h, a, b, target, midpoint)) return false;
     live_faces_ -= mesh_.is_boundary(e) ? 1 : 2;
     // The two faces of the edge go: their input vertices move to the survivor's faces. In each,
     // the edges from a and b to the tip merge; the merged edge is a feature if either was.
@@ -1149,22 +1136,37 @@ private:
       if (kept.is_valid()) feature(mesh_.edge_handle(kept)) = merged[t];
     }
     // A repair comes after the last smoothing: its survivor is placed on the input at once.
-    if (midpoint) mesh_.set_point(b, repair ? relocate(b, target, b) : target);
+    if (midpoint) mesh_.set_point(b, is_repair(purpose) ? relocate(b, target, b) : target);
     place_points_around(b, displaced_);
     return true;
   }
 
-  // The geometric rules of try_collapse() for collapsing h (a into b) with the survivor at
-  // `target`: where the first choice fails, a collapse the other way (and for a repair into
-  // either endpoint) may be taken instead, which updates h, a, b, target and midpoint.
+  // The rules of try_collapse() beyond the kinds, for collapsing h (a into b) with the survivor
+  // at `target`: the manifold rule, and unless a and b are at one point the geometric ones.
+  // Where the first choice fails, a collapse the other way (and for a repair into either
+  // endpoint) may be taken instead, which updates h, a, b, target and midpoint.
   bool collapse_allowed(Collapse purpose, HalfedgeHandle& h, VertexHandle& a, VertexHandle& b,
                         Vec3& target, bool& midpoint) const {
+    if ((mesh_.point(a) - mesh_.point(b)).sqrnorm() <= 1e-12 * hi2_) {
+      // Two vertices at one point (the smoothing, moving all vertices at once, placed both on
+      // the same input vertex or crack tip): merging them changes no remaining face, it only
+      // removes the two flat ones; so only the kinds and the manifold rule hold here.
+      // Otherwise a cluster of such vertices never went: each collapse left a flat face.
+      bool ok = collapse_keeps_manifold(h);
+      if (!ok && midpoint) {
+        h = mesh_.opposite_halfedge_handle(h);
+        std::swap(a, b);
+        ok = collapse_keeps_manifold(h);
+      }
+      target = mesh_.point(b);
+      midpoint = false;
+      return ok;
+    }
     // A repair may leave an edge up to √1.4 × 4/3 l ≈ 1.58 l long (one long edge costs the
     // Laplacian less than a sliver), and must raise the smallest angle around it. The length
     // test comes first: it is the cheapest and the one that fails most (two thirds of the short
     // edges of a cycle cannot go without leaving an edge longer than 4/3 l).
-    const bool repair =
-        purpose == Collapse::Repair || purpose == Collapse::Flat || purpose == Collapse::Degenerate;
+    const bool repair = is_repair(purpose);
     const double reach2 = purpose == Collapse::Short                                 ? hi2_
                           : purpose == Collapse::Repair || purpose == Collapse::Flat ? 1.4 * hi2_
                                                                                      : 4 * hi2_;
@@ -1251,20 +1253,12 @@ private:
   // at 10 cycles, where the blade's rim curls up from the plate: the goal's closest point lies
   // on the plate, but relocate()'s walk from the rim stops on the rim).
   bool try_repair_move(VertexHandle v) {
-    if (kind(v) != Kind::Interior || mesh_.is_boundary(v)) return false;
-    Vec3 centroid(0, 0, 0);
-    int k = 0;
-    for (auto w : mesh_.vv_range(v)) {
-      centroid += mesh_.point(w);
-      ++k;
-    }
-    if (k < 3) return false;
+    Vec3 goal;
+    if (kind(v) != Kind::Interior || mesh_.is_boundary(v) || !centroid_target(v, goal))
+      return false;
     const Vec3 p = mesh_.point(v);
-    Vec3 u = centroid / k - p;
-    const Vec3 n = vertex_normal(v);
-    u -= n * OpenMesh::dot(n, u);
-    const SurfacePoint there = closest_around(p + u, p, loc(v).face, 2 * length_);
-    const Vec3 q = options_.project ? evaluate(input_, there) : p + u;
+    const SurfacePoint there = closest_around(goal, p, loc(v).face, 2 * length_);
+    const Vec3 q = options_.project ? evaluate(input_, there) : goal;
     if (!ring_keeps_faces(v, q) || !(ring_min_angle(v, q) > ring_min_angle(v, p))) return false;
     loc(v) = there;
     mesh_.set_point(v, q);
@@ -1767,20 +1761,26 @@ private:
   void tangential_smoothing() {
     move_vertices([&](VertexHandle v, Vec3& goal) {
       if (kind(v) == Kind::Curve) return curve_target(v, 0.5, goal);
-      Vec3 centroid(0, 0, 0);
-      int k = 0;
-      for (auto w : mesh_.vv_range(v)) {
-        centroid += mesh_.point(w);
-        ++k;
-      }
-      if (k == 0) return false;
-      const Vec3 p = mesh_.point(v);
-      Vec3 u = centroid / k - p;
-      const Vec3 n = vertex_normal(v);
-      u -= n * OpenMesh::dot(n, u);
-      goal = p + u;
-      return true;
+      return centroid_target(v, goal);
     });
+  }
+
+  // v's one-ring centroid, the move to it projected into v's tangent plane; false for an
+  // isolated vertex.
+  bool centroid_target(VertexHandle v, Vec3& goal) const {
+    Vec3 centroid(0, 0, 0);
+    int k = 0;
+    for (auto w : mesh_.vv_range(v)) {
+      centroid += mesh_.point(w);
+      ++k;
+    }
+    if (k == 0) return false;
+    const Vec3 p = mesh_.point(v);
+    Vec3 u = centroid / k - p;
+    const Vec3 n = vertex_normal(v);
+    u -= n * OpenMesh::dot(n, u);
+    goal = p + u;
+    return true;
   }
 
   // One fine-tuning iteration; returns the number of Delaunay flips it made.
