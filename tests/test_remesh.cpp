@@ -256,6 +256,29 @@ TEST(Remesh, FineTuningGrowsTheBoundaryCellsWithinTheBand) {
             long_boundary_edges(off.mesh, opt.target_length) + 2);
 }
 
+// The heavy-ball momentum of the fine-tuning (equalize_momentum) speeds up its convergence: in
+// the same 6 iterations the area spread and the full symmetry defect (the boundary cells'
+// deficit has to travel several rings inwards) end lower than without, and the triangles keep
+// their shape.
+TEST(Remesh, MomentumSpeedsUpTheFineTuning) {
+  const Mesh input = make_annulus(40, 256, 0.5, 1.5);
+  RemeshOptions opt;
+  opt.target_length = 0.05;
+  opt.equalize_momentum = 0;
+  const RemeshReport off = remesh(input, opt).report;
+  opt.equalize_momentum = 0.5;
+  const RemeshResult on = remesh(input, opt);
+  expect_sound_output(on, input);
+  const RemeshReport& rep = on.report;
+  EXPECT_LT(rep.symmetry_defect_output, 0.95 * off.symmetry_defect_output);
+  EXPECT_LT(rep.after_equalization.mixed_area.rel_std,
+            0.95 * off.after_equalization.mixed_area.rel_std);
+  EXPECT_GE(rep.after_equalization.angles.min_deg, 25.0);
+  EXPECT_LT(rep.after_equalization.angles.mean_abs_deviation_from_60_deg,
+            off.after_equalization.angles.mean_abs_deviation_from_60_deg + 0.5);
+  EXPECT_GE(fraction_in_band(on.mesh, opt.target_length), 0.99);
+}
+
 // Islands and holes a few target lengths around keep three corners spread around them. A
 // single triangle, a hexagon and a round 48-gon, 2.5 to 6 l around, used to be smoothed and
 // collapsed into flat or tiny triangles (a raw scan's specks: lato000.ply).
@@ -803,21 +826,21 @@ TEST_P(RemeshData, MeetsThePapersAreaFigures) {
   }
 }
 
-// The paper's area figures on real open meshes. Their boundary vertices span half a turn and so
-// have about half the mean area; only the interior rows can meet the symmetry figure.
+// The paper's area figures on real open meshes. Their boundary vertices span half a turn, so
+// their cells end at the boundary and stay below the mean area (about 0.7 Ā within the edge
+// band); the fine-tuning grows them (equalize_boundary) and, with its momentum, carries their
+// deficit far enough inwards that the full symmetry defect meets the figure too (AcrossRiver
+// 0.063 -> 0.059 with the momentum, camelhead 0.057 -> 0.051).
 class RemeshOpenData : public ::testing::TestWithParam<const char*> {};
 
-TEST_P(RemeshOpenData, MeetsThePapersAreaFiguresInside) {
+TEST_P(RemeshOpenData, MeetsThePapersAreaFiguresWithTheBoundaryRows) {
   const std::string path = shared_mesh(GetParam());
   if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " not present";
   const Mesh input = read_mesh(path).mesh;
   const RemeshResult r = remesh(input);
   expect_sound_output(r, input);
-  expect_papers_area_figures(r, SymmetryRows::Interior);
+  expect_papers_area_figures(r, SymmetryRows::All);
   EXPECT_LT(r.report.symmetry_defect_output_interior, r.report.symmetry_defect_output);
-  // The boundary cells grown by the fine-tuning (equalize_boundary): camelhead 0.078 -> 0.061,
-  // AcrossRiver 0.142 -> 0.087.
-  EXPECT_LT(r.report.symmetry_defect_output, 0.1);
 }
 
 INSTANTIATE_TEST_SUITE_P(OpenMeshes, RemeshOpenData,

@@ -121,6 +121,11 @@ void add_remesh_command(CLI::App& app) {
                   "newton: weight of the shape-keeping smoothing term")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
+  cmd->add_option("--momentum", o.equalize_momentum,
+                  "newton: each fine-tuning move adds this fraction of the vertex's previous move "
+                  "(heavy-ball momentum; 0 = off)")
+      ->check(CLI::Range(0.0, 0.99))
+      ->capture_default_str();
   cmd->add_flag("!--no-equalize-flips", o.equalize_flips,
                 "Skip the Delaunay flips after each area-equalizing iteration");
   cmd->add_option("--guard-angle", o.equalize_guard_deg,

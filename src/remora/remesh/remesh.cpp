@@ -248,6 +248,7 @@ public:
       });
 
     timed("equalize", [&] {
+      previous_points_.clear(); // the first iteration has no previous move
       for (int it = 0; it < options_.equalize_iterations; ++it) {
         progress("equalize", it, options_.equalize_iterations);
         report.delaunay_flips += equalize_areas();
@@ -1903,6 +1904,14 @@ private:
     if (count == 0) return;
     const double target = sum / static_cast<double>(count);
     const double eps = 1e-4 * length_;
+    // Heavy-ball momentum (equalize_momentum): the positions at the start of the previous
+    // iteration give each vertex's last move. Vertices are neither added nor removed between
+    // iterations (the Delaunay flips only reconnect them).
+    const double beta = options_.equalize_momentum;
+    const bool momentum = beta > 0 && previous_points_.size() == mesh_.n_vertices();
+    current_points_.resize(mesh_.n_vertices());
+    for (auto v : mesh_.vertices())
+      current_points_[static_cast<std::size_t>(v.idx())] = mesh_.point(v);
     auto newton_goal = [&](VertexHandle v, Vec3& goal, Ring& r) {
       if (kind(v) != Kind::Interior) return false;
       const Vec3 p = mesh_.point(v);
@@ -1996,6 +2005,11 @@ private:
       if (!(jtj.determinant() > 0)) return false;
       const Eigen::Vector2d step = -jtj.inverse() * jtr * options_.lambda;
       Vec3 d = t1 * step[0] + t2 * step[1];
+      if (momentum) { // β × the last move, in today's tangent plane
+        Vec3 last = p - previous_points_[static_cast<std::size_t>(v.idx())];
+        last -= n * OpenMesh::dot(n, last);
+        d += last * beta;
+      }
       // Never move by more than a fraction of the target length in one iteration.
       const double cap = 0.2 * length_;
       if (d.norm() > cap) d *= cap / d.norm();
@@ -2012,6 +2026,7 @@ private:
       }
       return guarded_place(v, goal, r, out);
     });
+    std::swap(previous_points_, current_points_);
   }
 
   // The cosine of the smallest angle of the triangle (a, b, c); 1 when degenerate.
@@ -2037,12 +2052,13 @@ private:
   std::vector<SurfacePoint> track_;
   std::vector<int> next_, prev_;
   std::vector<int> displaced_; // scratch: input vertices taken off faces an operation changes
-  std::vector<SurfacePoint> reprojected_;        // scratch of reproject_points()
-  std::vector<Vec3> placed_;                     // scratch of move_vertices()
-  std::vector<Placed> moves_;                    // scratch of move_vertices()
-  std::vector<char> marked_;                     // scratch of delaunay_flips()
-  std::vector<std::array<double, 4>> face_data_; // scratch of equalize_areas_newton()
-  std::vector<double> vertex_areas_;             // scratch of equalize_areas_newton()
+  std::vector<SurfacePoint> reprojected_;              // scratch of reproject_points()
+  std::vector<Vec3> placed_;                           // scratch of move_vertices()
+  std::vector<Placed> moves_;                          // scratch of move_vertices()
+  std::vector<char> marked_;                           // scratch of delaunay_flips()
+  std::vector<std::array<double, 4>> face_data_;       // scratch of equalize_areas_newton()
+  std::vector<double> vertex_areas_;                   // scratch of equalize_areas_newton()
+  std::vector<Vec3> previous_points_, current_points_; // equalize_areas_newton(): momentum
   void add_working_properties() {
     mesh_.add_property(loc_prop_);
     mesh_.add_property(bloc_prop_);
@@ -2080,6 +2096,8 @@ RemeshResult remesh(const Mesh& input, const RemeshOptions& options) {
     throw InvalidArgument("remesh: lambda must be in (0, 1]");
   if (!(options.equalize_smoothing >= 0 && std::isfinite(options.equalize_smoothing)))
     throw InvalidArgument("remesh: equalize_smoothing must be finite and >= 0");
+  if (!(options.equalize_momentum >= 0 && options.equalize_momentum < 1))
+    throw InvalidArgument("remesh: equalize_momentum must be in [0, 1) (0 = off)");
   if (!(options.corner_angle_deg >= 0 && options.corner_angle_deg <= 180))
     throw InvalidArgument("remesh: corner_angle_deg must be in [0, 180] degrees");
   if (!(options.equalize_guard_deg >= 0 && options.equalize_guard_deg < 60))
