@@ -264,6 +264,7 @@ TEST(Remesh, MomentumSpeedsUpTheFineTuning) {
   const Mesh input = make_annulus(40, 256, 0.5, 1.5);
   RemeshOptions opt;
   opt.target_length = 0.05;
+  opt.equalize_iterations = 6;
   opt.equalize_momentum = 0;
   const RemeshReport off = remesh(input, opt).report;
   opt.equalize_momentum = 0.5;

@@ -41,9 +41,11 @@ struct RemeshOptions {
   /// 0.2–0.9° on every mesh of docs/remesh.md's table (with 7 fine-tuning iterations: bunny
   /// 7.54° → 6.97°, conrod 7.84° → 6.93°) and the area figures with it.
   int cycles = 7;
-  /// Iterations of the area-equalizing fine-tuning (§4); 0 skips it. After 7 cycles, 6 at
-  /// λ = 0.8 meet the goals that 7 at λ = 0.75 meet (docs/remesh.md).
-  int equalize_iterations = 6;
+  /// Iterations of the area-equalizing fine-tuning (§4); 0 skips it. With the momentum below the
+  /// figures swing for a few iterations before they settle: 9 is the first count from which on
+  /// (9, 10, 12, 16 measured) AcrossRiver meets the full symmetry defect and gears the mean angle
+  /// at once (6 and 9 without the momentum until session 12; docs/remesh.md, "Momentum").
+  int equalize_iterations = 9;
   Equalization equalization = Equalization::Newton;
   /// Damping factor λ of the area-equalizing update (both methods).
   double lambda = 0.8;
@@ -52,9 +54,10 @@ struct RemeshOptions {
   /// Newton only: heavy-ball momentum β (Polyak). Each fine-tuning move adds β × the vertex's
   /// previous move (taken into its tangent plane): the damped per-vertex (Jacobi) steps are slow
   /// on area errors that span many rings (the deficit of the boundary cells), and the momentum
-  /// carries them further. At 0.5 the variance reduction grows from 6–8.5× to 7.5–11× and
-  /// AcrossRiver's full symmetry defect falls from 0.063 to 0.059 (the goal), for +0.1° of
-  /// mean |θ−60°| (docs/remesh.md). 0 turns it off; must be < 1.
+  /// carries them further. At 0.5 and 9 iterations, against 0 and 6, the variance reduction
+  /// grows from 5.9–8.5× to 6.9–10.4×, AcrossRiver's full symmetry defect falls from 0.063 to
+  /// 0.059 (the goal) and the mean |θ−60°| falls on most meshes too (gears 7.02° → 6.97°;
+  /// docs/remesh.md). 0 turns it off; must be < 1.
   double equalize_momentum = 0.5;
   /// After every fine-tuning iteration, flip the edges whose opposite angles sum to more than π
   /// (intrinsic Delaunay flips): the fine-tuning then costs less triangle shape (docs/remesh.md).
