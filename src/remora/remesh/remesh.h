@@ -44,7 +44,7 @@ struct RemeshOptions {
   /// Iterations of the area-equalizing fine-tuning (§4); 0 skips it. With the momentum below the
   /// figures swing for a few iterations before they settle: 9 is the first count from which on
   /// (9, 10, 12, 16 measured) AcrossRiver meets the full symmetry defect and gears the mean angle
-  /// at once (6 and 9 without the momentum until session 12; docs/remesh.md, "Momentum").
+  /// at once (6, without the momentum, until session 12; docs/remesh.md, "Momentum").
   int equalize_iterations = 9;
   Equalization equalization = Equalization::Newton;
   /// Damping factor λ of the area-equalizing update (both methods).
