@@ -755,6 +755,11 @@ TEST(Remesh, RejectsBadOptions) {
     EXPECT_THROW(remesh(input, opt), InvalidArgument) << weight;
     opt.equalize_smoothing = 1.5;
   }
+  for (double beta : {-0.1, 1.0, 2.0, std::nan("")}) {
+    opt.equalize_momentum = beta;
+    EXPECT_THROW(remesh(input, opt), InvalidArgument) << beta;
+    opt.equalize_momentum = 0.5;
+  }
   for (double angle : {-1.0, 181.0, std::nan("")}) {
     opt.corner_angle_deg = angle;
     EXPECT_THROW(remesh(input, opt), InvalidArgument) << angle;
