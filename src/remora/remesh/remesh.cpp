@@ -960,8 +960,8 @@ private:
   // Does collapsing h (its source into its target) keep the mesh a manifold? The link condition
   // (the only common neighbours of the endpoints are the tips of the edge's faces), no face with
   // two boundary edges, no interior edge between two boundary vertices, and no collapse of a
-  // closed tetrahedron. OpenMesh's is_collapse_ok tests the same with vertex tags; this one keeps the
-  // first ring in a small array (about 7 % of a remesh faster).
+  // closed tetrahedron. OpenMesh's is_collapse_ok tests the same with vertex tags; this one
+  // keeps the first ring in a small array (about 7 % of a remesh faster).
   bool collapse_keeps_manifold(HalfedgeHandle h) const {
     const HalfedgeHandle o = mesh_.opposite_halfedge_handle(h);
     const VertexHandle a = mesh_.from_vertex_handle(h), b = mesh_.to_vertex_handle(h);
@@ -1909,9 +1909,11 @@ private:
     // iterations (the Delaunay flips only reconnect them).
     const double beta = options_.equalize_momentum;
     const bool momentum = beta > 0 && previous_points_.size() == mesh_.n_vertices();
-    current_points_.resize(mesh_.n_vertices());
-    for (auto v : mesh_.vertices())
-      current_points_[static_cast<std::size_t>(v.idx())] = mesh_.point(v);
+    if (beta > 0) { // no copy when the momentum is off
+      current_points_.resize(mesh_.n_vertices());
+      for (auto v : mesh_.vertices())
+        current_points_[static_cast<std::size_t>(v.idx())] = mesh_.point(v);
+    }
     auto newton_goal = [&](VertexHandle v, Vec3& goal, Ring& r) {
       if (kind(v) != Kind::Interior) return false;
       const Vec3 p = mesh_.point(v);
