@@ -9,7 +9,9 @@
 //
 // Without files: the CI meshes of ../shared/data/MANIFEST.md that load as manifolds (plus
 // derived/igea_sub4.ply with --large). l = 0.9 x the loaded mesh's length scale (its mean edge length unless needles inflate it), as remesh()
-// computes it; Remora's default number of cycles for both (--cycles). Ours runs twice per round:
+// computes it; for both the number of cycles Remora's default options run on the mesh (at least 7,
+// more while the cycles still change a CAD part: the first run of ours tells it), or exactly
+// --cycles N for both. Ours runs twice per round:
 // default options (cycles + the default equalization iterations) and cycles only (equalize_iterations = 0, the like-for-like comparison). CGAL keeps
 // the mesh boundary by default: boundary edges are split at midpoints and collapsed onto boundary
 // vertices, boundary vertices are not smoothed (--cgal-relax-boundary lets them slide along
@@ -56,7 +58,7 @@ constexpr double kLengthFactor = 0.9;
 
 struct Args {
   int repeat = 3;
-  int cycles = remora::RemeshOptions{}.cycles; // for both contenders
+  int cycles = 0; // for both contenders; 0: as many as Remora's default options run
   bool large = false;
   bool json = false;
   int threads = 0;
@@ -234,6 +236,7 @@ struct MeshRace {
   std::size_t input_boundary_loops = 0;
   double target_length = 0;
   double load_ms = 0;
+  int cycles = 0; ///< cycles both ran
   Variant ours_eq{
       fmt::format("ours (+{} equalize)", remora::RemeshOptions{}.equalize_iterations), {}, {}, {}};
   Variant ours_cycles{"ours (cycles only)", {}, {}, {}};
@@ -257,7 +260,8 @@ void race(MeshRace& r, const Args& args) {
 
   remora::RemeshOptions eq_options;
   eq_options.target_length = l; // what the default (length_factor 0.9) gives; explicit = same l
-  eq_options.cycles = args.cycles;
+  if (args.cycles > 0) eq_options.cycles = eq_options.max_cycles = args.cycles;
+  r.cycles = args.cycles; // else known after ours' first run
   eq_options.threads = args.threads;
   eq_options.feature_angle_deg = args.feature_angle;
   // CGAL computes no quality figures either; both outputs are measured afterwards, untimed.
@@ -274,7 +278,7 @@ void race(MeshRace& r, const Args& args) {
     CGAL::Polygon_mesh_processing::detect_sharp_edges(cgal_marked, args.feature_angle, constrained);
   // The map of the mesh being remeshed (the copy carries the property along).
   auto cgal_parameters = [&](SurfaceMesh& sm) {
-    return CGAL::parameters::number_of_iterations(args.cycles)
+    return CGAL::parameters::number_of_iterations(r.cycles)
         .protect_constraints(false)
         .relax_constraints(args.cgal_relax_boundary)
         .edge_is_constrained_map(
@@ -289,6 +293,10 @@ void race(MeshRace& r, const Args& args) {
     const Timing t = timed([&] { result.emplace(remora::remesh(input, options)); });
     if (variant.runs.empty() || t.wall_ms < variant.best_wall())
       variant.phase_ms = result->report.milliseconds;
+    if (r.cycles == 0) { // the count Remora's options ran: CGAL and the cycles-only run get it
+      r.cycles = result->report.cycles;
+      cycles_options.cycles = cycles_options.max_cycles = r.cycles;
+    }
     variant.runs.push_back(t);
     out = std::move(result->mesh);
     return t;
@@ -375,6 +383,7 @@ nlohmann::json to_json(const MeshRace& r) {
                 {"boundary_loops", r.input_boundary_loops},
                 {"load_ms", r.load_ms}};
   j["target_length"] = r.target_length;
+  j["cycles"] = r.cycles;
   j["ours_equalized"] = to_json(r.ours_eq);
   j["ours_cycles_only"] = to_json(r.ours_cycles);
   j["cgal"] = to_json(r.cgal);
@@ -406,7 +415,7 @@ void print_variant(const Variant& v) {
              f.percent_interior_valence_6, fixed_or_na(f.boundary_deviation_over_l, 4));
 }
 
-void print_race(const MeshRace& r, int repeat, int cycles) {
+void print_race(const MeshRace& r, int repeat) {
   if (r.status == "missing") {
     fmt::print("## {}: skipped, file missing: {}\n\n", r.name, r.path);
     return;
@@ -417,7 +426,7 @@ void print_race(const MeshRace& r, int repeat, int cycles) {
   }
   fmt::print("## {} ({} faces, {} boundary loops), l = {:.6g} (0.9 x length scale), {} cycles, "
              "best of {}\n\n",
-             r.name, r.input_faces, r.input_boundary_loops, r.target_length, cycles, repeat);
+             r.name, r.input_faces, r.input_boundary_loops, r.target_length, r.cycles, repeat);
   fmt::print("| variant | faces out | wall ms | CPU ms | wall us/tri | CPU us/tri | min angle | "
              "mean abs(angle-60) | mixed area rel MAD | mean edge / l | % edges in [4/5,4/3]l | "
              "% val 6 | boundary dev / l |\n");
@@ -493,7 +502,8 @@ int main(int argc, char** argv) {
   app.add_option("meshes", args.files, "Mesh files (default: the CI meshes of ../shared/data)");
   app.add_option("--repeat", args.repeat, "Alternating rounds per mesh; best of N is reported")
       ->check(CLI::PositiveNumber);
-  app.add_option("--cycles", args.cycles, "Cycles for both contenders (default: Remora's)")
+  app.add_option("--cycles", args.cycles,
+                 "Cycles for both contenders, exactly (default: as many as Remora's defaults run)")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
   app.add_flag("--large", args.large, "Also run derived/igea_sub4.ply (1.07M triangles)");
@@ -559,7 +569,7 @@ int main(int argc, char** argv) {
         fmt::print(stderr, "[{}] error: {}\n", r.name, e.what());
       }
     }
-    if (!args.json) print_race(r, args.repeat, args.cycles);
+    if (!args.json) print_race(r, args.repeat);
     std::fflush(stdout);
     races.push_back(std::move(r));
   }

@@ -280,6 +280,31 @@ TEST(Remesh, MomentumSpeedsUpTheFineTuning) {
   EXPECT_GE(fraction_in_band(on.mesh, opt.target_length), 0.99);
 }
 
+// The cycles run at least `cycles` times, then again while the last one still split, collapsed
+// or flipped more than settle_fraction × the faces, up to max_cycles. A cube of 4 × 4 quads per
+// side keeps reconnecting around its creases at the default l.
+TEST(Remesh, ExtraCyclesRunWhileTheMeshStillChanges) {
+  const Mesh input = make_cube(4, 1.0);
+  RemeshOptions opt;
+  int reported = 0;
+  opt.progress = [&](std::string_view phase, int, int) { reported += phase == "remesh"; };
+  const RemeshResult adaptive = remesh(input, opt);
+  expect_sound_output(adaptive, input);
+  EXPECT_GT(adaptive.report.cycles, opt.cycles);
+  EXPECT_LE(adaptive.report.cycles, opt.max_cycles);
+  EXPECT_EQ(reported, adaptive.report.cycles);
+  opt.progress = nullptr;
+  opt.compute_report = false;
+  opt.settle_fraction = 1; // never an extra cycle
+  EXPECT_EQ(remesh(input, opt).report.cycles, opt.cycles);
+  opt.settle_fraction = 0.03;
+  opt.cycles = 5;
+  opt.max_cycles = 3; // below `cycles`: exactly `cycles`
+  EXPECT_EQ(remesh(input, opt).report.cycles, 5);
+  opt.cycles = opt.max_cycles = 0;
+  EXPECT_EQ(remesh(input, opt).report.cycles, 0);
+}
+
 // Islands and holes a few target lengths around keep three corners spread around them. A
 // single triangle, a hexagon and a round 48-gon, 2.5 to 6 l around, used to be smoothed and
 // collapsed into flat or tiny triangles (a raw scan's specks: lato000.ply).
@@ -416,7 +441,9 @@ TEST(Remesh, BoundaryRunsAreThinnedToTheirSpacing) {
   EXPECT_LT(mean_before, 1.1);
   EXPECT_GT(mean_after, 1.15);
   EXPECT_LE(longest_after, 4.0 / 3.0);
-  EXPECT_GT(boundary_area_ratio(spaced.mesh), boundary_area_ratio(as_cycled.mesh) + 0.03);
+  // Boundary cells relative to the interior ones: 0.635 -> 0.664 (0.650 -> 0.684 with the
+  // fine-tuning's centroid target, session 12's default).
+  EXPECT_GT(boundary_area_ratio(spaced.mesh), boundary_area_ratio(as_cycled.mesh) + 0.02);
   EXPECT_LT(spaced.report.symmetry_defect_output, 0.9 * as_cycled.report.symmetry_defect_output);
   EXPECT_GE(spaced.report.after_equalization.angles.min_deg, 25.0);
   EXPECT_GE(fraction_in_band(spaced.mesh, opt.target_length), 0.99);
@@ -755,6 +782,14 @@ TEST(Remesh, RejectsBadOptions) {
     EXPECT_THROW(remesh(input, opt), InvalidArgument) << weight;
     opt.equalize_smoothing = 1.5;
   }
+  opt.max_cycles = -1;
+  EXPECT_THROW(remesh(input, opt), InvalidArgument);
+  opt.max_cycles = 12;
+  for (double fraction : {-0.1, 1.5, std::nan("")}) {
+    opt.settle_fraction = fraction;
+    EXPECT_THROW(remesh(input, opt), InvalidArgument) << fraction;
+    opt.settle_fraction = 0.03;
+  }
   for (double beta : {-0.1, 1.0, 2.0, std::nan("")}) {
     opt.equalize_momentum = beta;
     EXPECT_THROW(remesh(input, opt), InvalidArgument) << beta;
@@ -974,6 +1009,47 @@ TEST(RemeshBlade, NoFlatFacesAfterTenCycles) {
   const RemeshResult r = remesh(input, options);
   expect_sound_output(r, input);
   EXPECT_GE(mesh_quality(r.mesh).angles.min_deg, 25.0);
+}
+
+// featuretype.STL, a coarse CAD tessellation (3,476 faces, 74 % needles, a third of its edges
+// creases sharper than 30 degrees), meets every goal of docs/remesh.md's table. Its cycles keep
+// reconnecting around the creases: the extra cycles (11 here) take its mean |θ−60°| under 7°
+// (7.23° at 7 cycles), and the fine-tuning's pull towards the ODT point keeps 99 % of its edges
+// in the band (98.8 % with the centroid at its μ of 1.5, the same cycles).
+TEST(RemeshFeaturetype, MeetsEveryGoalWithTheExtraCyclesAndTheOdtTarget) {
+  const std::string path = shared_mesh("cad/featuretype.STL");
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " not present";
+  const Mesh input = read_mesh(path).mesh;
+  const RemeshResult r = remesh(input);
+  expect_sound_output(r, input);
+  const RemeshReport& rep = r.report;
+  // The paper's area figures (expect_papers_area_figures but its bound on the tracked
+  // locations, which are 3e-3 l farther than the closest points here, as on the other CAD parts).
+  EXPECT_LT(rep.after_equalization.mixed_area.rel_mad, 0.05);
+  EXPECT_GT(
+      std::pow(rep.after_cycles.mixed_area.rel_std / rep.after_equalization.mixed_area.rel_std,
+               2.0),
+      5.0);
+  EXPECT_LT(rep.symmetry_defect_output, 0.06);
+  EXPECT_LT(rep.tracked_excess_mean, 0.01);
+  EXPECT_GT(rep.cycles, RemeshOptions{}.cycles);
+  EXPECT_GE(rep.after_equalization.angles.min_deg, 25.0);
+  EXPECT_LT(rep.after_equalization.angles.mean_abs_deviation_from_60_deg, 7.0);
+  const double in_band = fraction_in_band(r.mesh, rep.target_length);
+  EXPECT_GE(in_band, 0.99);
+
+  RemeshOptions seven;
+  seven.max_cycles = seven.cycles;
+  seven.compute_report = false;
+  const RemeshResult fewer = remesh(input, seven);
+  EXPECT_GT(mesh_quality(fewer.mesh).angles.mean_abs_deviation_from_60_deg,
+            rep.after_equalization.angles.mean_abs_deviation_from_60_deg);
+  RemeshOptions centroid;
+  centroid.smoothing_target = SmoothingTarget::Centroid;
+  centroid.equalize_smoothing = 1.5;
+  centroid.compute_report = false;
+  const RemeshResult pulled = remesh(input, centroid);
+  EXPECT_LT(fraction_in_band(pulled.mesh, rep.target_length), in_band);
 }
 
 INSTANTIATE_TEST_SUITE_P(CiMeshes, RemeshUglyData,

@@ -71,10 +71,11 @@ void print_remesh_report(std::ostream& os, const RemeshReport& r) {
   if (r.feature_edges > 0)
     os << fmt::format("feature lines kept: {} input edges sharper than the feature angle\n",
                       grouped(r.feature_edges));
-  os << fmt::format("operations: {} splits, {} collapses, {} flips, {} repairs; {} Delaunay flips "
-                    "in the fine-tuning, {} of its moves shortened against slivers\n",
-                    grouped(r.splits), grouped(r.collapses), grouped(r.flips), grouped(r.repairs),
-                    grouped(r.delaunay_flips), grouped(r.guarded_moves));
+  os << fmt::format("operations: {} cycles; {} splits, {} collapses, {} flips, {} repairs; {} "
+                    "Delaunay flips in the fine-tuning, {} of its moves shortened against "
+                    "slivers\n",
+                    r.cycles, grouped(r.splits), grouped(r.collapses), grouped(r.flips),
+                    grouped(r.repairs), grouped(r.delaunay_flips), grouped(r.guarded_moves));
   std::string times;
   for (const auto& [phase, ms] : r.milliseconds) times += fmt::format("{} {:.0f} ms, ", phase, ms);
   if (!times.empty()) times.resize(times.size() - 2);
@@ -91,6 +92,7 @@ void add_remesh_command(CLI::App& app) {
     RemeshOptions options; ///< the library's defaults until a flag says otherwise
     double low_pass = 0;   ///< σ of the base-surface filter, in mean edge lengths; 0 = off
     std::string method = "newton";
+    std::string smoothing_target = "odt";
     bool no_project = false, report = false, json = false;
   };
   auto a = std::make_shared<Args>();
@@ -105,8 +107,19 @@ void add_remesh_command(CLI::App& app) {
       ->check(CLI::PositiveNumber)
       ->excludes(length)
       ->capture_default_str();
-  cmd->add_option("--cycles", o.cycles, "Split/collapse/flip/smooth cycles")
+  cmd->add_option("--cycles", o.cycles,
+                  "Split/collapse/flip/smooth cycles, at least (more while they still change "
+                  "the mesh, up to --max-cycles)")
       ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  cmd->add_option("--max-cycles", o.max_cycles,
+                  "At most this many cycles (at or below --cycles: exactly --cycles)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  cmd->add_option("--settle", o.settle_fraction,
+                  "Add a cycle while the last one split, collapsed or flipped more than this "
+                  "fraction of the faces (1 = never)")
+      ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
   cmd->add_option("--equalize", o.equalize_iterations, "Area-equalizing iterations")
       ->check(CLI::NonNegativeNumber)
@@ -121,6 +134,10 @@ void add_remesh_command(CLI::App& app) {
                   "newton: weight of the shape-keeping smoothing term")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
+  cmd->add_option("--smoothing-target", a->smoothing_target,
+                  "newton: where the smoothing term pulls: odt (default; the one-ring's "
+                  "circumcentres weighted by area) or centroid (weaker pull: try --smoothing 1.5)")
+      ->check(CLI::IsMember({"odt", "centroid"}));
   cmd->add_option("--momentum", o.equalize_momentum,
                   "newton: each fine-tuning move adds this fraction of the vertex's previous move "
                   "(heavy-ball momentum; 0 = off)")
@@ -171,6 +188,8 @@ void add_remesh_command(CLI::App& app) {
     }
     RemeshOptions options = a->options;
     options.equalization = a->method == "gravity" ? Equalization::Gravity : Equalization::Newton;
+    options.smoothing_target =
+        a->smoothing_target == "centroid" ? SmoothingTarget::Centroid : SmoothingTarget::Odt;
     options.project = !a->no_project;
     options.compute_report = a->report || a->json; // the figures cost 10-16 % of the time
     ProgressLine progress;

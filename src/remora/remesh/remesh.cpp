@@ -225,15 +225,26 @@ public:
     init_locations();
     report.feature_edges = feature_count_;
     init_points();
-    for (int cycle = 0; cycle < options_.cycles; ++cycle) {
-      progress("remesh", cycle, options_.cycles);
+    // At least options_.cycles cycles, then more while the last one still reconnected more than
+    // settle_fraction of the faces (CAD parts keep doing so around their creases), up to
+    // max_cycles.
+    const int max_cycles = std::max(options_.cycles, options_.max_cycles);
+    for (int cycle = 0; cycle < max_cycles; ++cycle) {
+      progress("remesh", cycle, std::max(options_.cycles, cycle + 1));
       if (cycle == 1 && options_.boundary_spacing > 1)
         timed("collapse", [&] { report.collapses += resample_boundary(); });
+      const std::size_t before = report.splits + report.collapses + report.flips;
       timed("split", [&] { report.splits += split_long_edges(); });
       timed("collapse", [&] { report.collapses += collapse_short_edges(); });
       timed("flip", [&] { report.flips += equalize_valences(); });
+      const std::size_t changes = report.splits + report.collapses + report.flips - before;
       timed("smooth", [&] { tangential_smoothing(); });
-      if (cycle == 0 && options_.cycles > 1) timed("reorder", [&] { compact(); });
+      report.cycles = cycle + 1;
+      if (cycle == 0 && max_cycles > 1) timed("reorder", [&] { compact(); });
+      if (cycle + 1 >= options_.cycles &&
+          static_cast<double>(changes) <=
+              options_.settle_fraction * static_cast<double>(live_faces_))
+        break;
     }
     timed("reorder", [&] { compact(); });
     timed("repair", [&] { report.repairs += repair_bad_triangles(options_.repair_angle_deg); });
@@ -1999,7 +2010,9 @@ private:
         jtj += row * row.transpose();
         jtr += row * (area[static_cast<std::size_t>(w.idx())] - target);
       }
-      const Vec3 off = p - centroid;
+      const Vec3 off =
+          p - (options_.smoothing_target == SmoothingTarget::Odt ? odt_point(p, r, centroid)
+                                                                 : centroid);
       const double mu = options_.equalize_smoothing * 0.5 * jtj.trace();
       jtj(0, 0) += mu;
       jtj(1, 1) += mu;
@@ -2029,6 +2042,27 @@ private:
       return guarded_place(v, goal, r, out);
     });
     std::swap(previous_points_, current_points_);
+  }
+
+  // The ODT point of v's closed one-ring `r` (v at p): the circumcentres of its faces weighted
+  // by their areas, the vertex update of the optimal Delaunay triangulation energy (Chen & Xu
+  // 2004; Alliez et al. 2005). A face's weight × its circumcentre's offset from p is bounded
+  // (area × circumradius = the product of its sides / 4), so slivers do not throw it far;
+  // `fallback` (the centroid) when the faces have no area.
+  Vec3 odt_point(const Vec3& p, const Ring& r, const Vec3& fallback) const {
+    Vec3 sum(0, 0, 0);
+    double weight = 0;
+    for (int j = 0; j < r.k; ++j) {
+      if (!r.face[j].is_valid()) continue;
+      const Vec3 a = mesh_.point(r.ring[j]) - p, b = mesh_.point(r.ring[r.third[j]]) - p;
+      const Vec3 axb = OpenMesh::cross(a, b);
+      const double twice_area = axb.norm();
+      if (!(twice_area > 0)) continue;
+      // Circumcentre offset: (|a|² b − |b|² a) × (a × b) / (2 |a × b|²); times the area.
+      sum += OpenMesh::cross(b * a.sqrnorm() - a * b.sqrnorm(), axb) / (4 * twice_area);
+      weight += 0.5 * twice_area;
+    }
+    return weight > 0 ? p + sum / weight : fallback;
   }
 
   // The cosine of the smallest angle of the triangle (a, b, c); 1 when degenerate.
@@ -2088,8 +2122,12 @@ private:
 
 RemeshResult remesh(const Mesh& input, const RemeshOptions& options) {
   if (input.n_faces() == 0) throw InvalidArgument("remesh: the input mesh has no faces");
-  if (options.cycles < 0 || options.equalize_iterations < 0 || options.threads < 0)
-    throw InvalidArgument("remesh: cycles, equalize_iterations and threads must be >= 0");
+  if (options.cycles < 0 || options.max_cycles < 0 || options.equalize_iterations < 0 ||
+      options.threads < 0)
+    throw InvalidArgument(
+        "remesh: cycles, max_cycles, equalize_iterations and threads must be >= 0");
+  if (!(options.settle_fraction >= 0 && options.settle_fraction <= 1))
+    throw InvalidArgument("remesh: settle_fraction must be in [0, 1] (1 = no extra cycles)");
   if (!std::isfinite(options.target_length) || !(options.length_factor > 0) ||
       !std::isfinite(options.length_factor))
     throw InvalidArgument("remesh: the target length and length factor must be finite, and the "
@@ -2140,6 +2178,7 @@ nlohmann::json to_json(const RemeshReport& r) {
   return {{"target_length", r.target_length},
           {"length_from_area", r.length_from_area},
           {"feature_edges", r.feature_edges},
+          {"cycles", r.cycles},
           {"input", to_json(r.input)},
           {"after_cycles", to_json(r.after_cycles)},
           {"after_equalization", to_json(r.after_equalization)},

@@ -30,17 +30,32 @@ enum class Equalization {
   Newton,  ///< a damped Gauss-Newton step on the area residuals of the one-ring
 };
 
+/// The point that the Newton fine-tuning's smoothing term pulls a vertex towards.
+enum class SmoothingTarget {
+  Centroid, ///< the uniform centroid of the one-ring (the cycles' tangential smoothing)
+  Odt,      ///< the one-ring's circumcentres weighted by triangle area (optimal Delaunay
+            ///< triangulation, Chen & Xu 2004; Alliez et al. 2005)
+};
+
 struct RemeshOptions {
   /// Absolute target edge length l; when <= 0, l = length_factor × the input's mean edge length
   /// (the paper: "slightly less than the average"), or × its area-based length when needles
   /// inflate the mean (length_scale() in geometry/measures.h).
   double target_length = 0.0;
   double length_factor = 0.9;
-  /// Cycles of split (> 4/3 l), collapse (< 4/5 l), valence flips, tangential smoothing. The
-  /// paper says about 5; the cycles are still converging there: 7 took the mean |θ−60°| down by
-  /// 0.2–0.9° on every mesh of docs/remesh.md's table (with 7 fine-tuning iterations: bunny
-  /// 7.54° → 6.97°, conrod 7.84° → 6.93°) and the area figures with it.
+  /// Cycles of split (> 4/3 l), collapse (< 4/5 l), valence flips, tangential smoothing: at
+  /// least `cycles`, then more, up to `max_cycles`, while the last one still split, collapsed or
+  /// flipped more than `settle_fraction` × the faces. The paper says about 5; the cycles are
+  /// still converging there: 7 took the mean |θ−60°| down by 0.2–0.9° on every mesh of
+  /// docs/remesh.md's table (bunny 7.54° → 6.97°, conrod 7.84° → 6.93°). Organic and open
+  /// meshes settle by then (their seventh cycle touches 0.75–2.8 % of the faces); CAD parts keep
+  /// reconnecting around their creases (5 %) and gain from 2–4 more (featuretype 7.23° → 6.91°).
   int cycles = 7;
+  /// The most cycles; values below `cycles` mean `cycles` (no extra cycles).
+  int max_cycles = 12;
+  /// An extra cycle runs while the last cycle's splits, collapses and valence flips together
+  /// exceed this fraction of the faces. In [0, 1]; 1 never adds a cycle.
+  double settle_fraction = 0.03;
   /// Iterations of the area-equalizing fine-tuning (§4); 0 skips it. With the momentum below the
   /// figures swing for a few iterations before they settle: 9 is the first count from which on
   /// (9, 10, 12, 16 measured) AcrossRiver meets the full symmetry defect and gears the mean angle
@@ -50,7 +65,12 @@ struct RemeshOptions {
   /// Damping factor λ of the area-equalizing update (both methods).
   double lambda = 0.8;
   /// Newton only: weight μ of the tangential-smoothing term, relative to the area term.
-  double equalize_smoothing = 1.5;
+  double equalize_smoothing = 2.5;
+  /// Newton only: where the smoothing term pulls. The ODT point keeps more edges in the band
+  /// [4/5 l, 4/3 l] than the centroid at the same mean |θ−60°| (featuretype 98.8 → 99.4 %,
+  /// blade 98.6 → 99.3 %) and equalizes areas further (variance reduction 6.9–10.4× → 7.4–12×);
+  /// its pull is weaker, hence μ = 2.5 against the centroid's 1.5 (docs/remesh.md, session 13).
+  SmoothingTarget smoothing_target = SmoothingTarget::Odt;
   /// Newton only: heavy-ball momentum β (Polyak). Each fine-tuning move adds β × the vertex's
   /// previous move (taken into its tangent plane): the damped per-vertex (Jacobi) steps are slow
   /// on area errors that span many rings (the deficit of the boundary cells), and the momentum
@@ -110,6 +130,7 @@ struct RemeshReport {
   double target_length = 0.0;
   bool length_from_area = false; ///< l came from the area per vertex (a needle-ridden input)
   std::size_t feature_edges = 0; ///< input edges found sharper than feature_angle_deg
+  int cycles = 0;                ///< cycles run (cycles to max_cycles)
   MeshQuality input;
   MeshQuality after_cycles;
   MeshQuality after_equalization;
@@ -152,8 +173,8 @@ struct RemeshResult {
 
 /// Remeshes `input` (a repaired, manifold triangle mesh). Throws InvalidArgument for an empty
 /// mesh, a non-finite or non-positive target length, negative counts, or an option outside its
-/// range (lambda, equalize_smoothing, equalize_momentum, equalize_guard_deg, corner_angle_deg,
-/// boundary_spacing, feature_angle_deg).
+/// range (settle_fraction, lambda, equalize_smoothing, equalize_momentum, equalize_guard_deg,
+/// corner_angle_deg, boundary_spacing, feature_angle_deg).
 RemeshResult remesh(const Mesh& input, const RemeshOptions& options = {});
 
 nlohmann::json to_json(const RemeshReport& report);
