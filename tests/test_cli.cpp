@@ -18,6 +18,7 @@
 #include "remora/geometry/quality.h"
 #include "remora/mesh/io.h"
 #include "remora/mesh/primitives.h"
+#include "remora/remesh/remesh.h"
 
 namespace remora {
 namespace {
@@ -154,6 +155,8 @@ TEST_F(Cli, RemeshWritesTheMeshAndAReportThatAgreesWithIt) {
   const LoadResult back = read_mesh(out.string());
   EXPECT_EQ(j["after_equalization"]["faces"], back.mesh.n_faces());
   EXPECT_EQ(j["target_length"], 0.2);
+  EXPECT_GE(j["cycles"], RemeshOptions{}.cycles);
+  EXPECT_LE(j["cycles"], RemeshOptions{}.max_cycles);
   EXPECT_EQ(j["distance_to_input"]["vertex_max"], 0.0);
   const CliRun table = run("remesh " + in.string() + " -o " + out.string() + " --report");
   ASSERT_EQ(table.exit_code, 0) << table.err;
@@ -218,6 +221,10 @@ TEST_F(Cli, RemeshRejectsBadOptionsBeforeWorking) {
       run("remesh " + in.string() + " -o " + (dir_ / "o.obj").string() + " --corner-angle 200")
           .exit_code,
       2);
+  for (const char* option : {" --settle 2", " --max-cycles -1", " --smoothing-target median"})
+    EXPECT_EQ(run("remesh " + in.string() + " -o " + (dir_ / "o.obj").string() + option).exit_code,
+              2)
+        << option;
   for (const auto& entry : fs::directory_iterator(dir_))
     EXPECT_EQ(entry.path().filename(), "sphere.off") << "left behind: " << entry.path();
 }

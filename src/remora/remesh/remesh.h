@@ -67,9 +67,10 @@ struct RemeshOptions {
   /// Newton only: weight μ of the tangential-smoothing term, relative to the area term.
   double equalize_smoothing = 2.5;
   /// Newton only: where the smoothing term pulls. The ODT point keeps more edges in the band
-  /// [4/5 l, 4/3 l] than the centroid at the same mean |θ−60°| (featuretype 98.8 → 99.4 %,
-  /// blade 98.6 → 99.3 %) and equalizes areas further (variance reduction 6.9–10.4× → 7.4–12×);
-  /// its pull is weaker, hence μ = 2.5 against the centroid's 1.5 (docs/remesh.md, session 13).
+  /// [4/5 l, 4/3 l] than the centroid (featuretype 98.8 → 99.4 % at the same 11 cycles, blade
+  /// 98.6 → 99.1 % at 7) and equalizes areas further (variance reduction 6.9–10.4× → 7.1–12.0×
+  /// on docs/remesh.md's table, with the extra cycles) for about 0.1° of mean |θ−60°|; its pull
+  /// is weaker, hence μ = 2.5 against the centroid's 1.5 (docs/remesh.md, session 13).
   SmoothingTarget smoothing_target = SmoothingTarget::Odt;
   /// Newton only: heavy-ball momentum β (Polyak). Each fine-tuning move adds β × the vertex's
   /// previous move (taken into its tangent plane): the damped per-vertex (Jacobi) steps are slow
