@@ -2020,9 +2020,9 @@ private:
         jtj += row * row.transpose();
         jtr += row * (area[static_cast<std::size_t>(w.idx())] - target);
       }
-      const Vec3 off =
-          p - (options_.smoothing_target == SmoothingTarget::Odt ? odt_point(p, r, centroid)
-                                                                 : centroid);
+      const Vec3 off = p - (options_.smoothing_target == SmoothingTarget::Odt
+                                ? odt_point(p, r, centroid, face_parts)
+                                : centroid);
       const double mu = options_.equalize_smoothing * 0.5 * jtj.trace();
       jtj(0, 0) += mu;
       jtj(1, 1) += mu;
@@ -2059,18 +2059,21 @@ private:
   // 2004; Alliez et al. 2005). A face's weight × its circumcentre's offset from p is bounded
   // (area × circumradius = the product of its sides / 4), so slivers do not throw it far;
   // `fallback` (the centroid) when the faces have no area.
-  Vec3 odt_point(const Vec3& p, const Ring& r, const Vec3& fallback) const {
+  // `parts` holds each face's mixed-area parts at the current positions: they sum to its area.
+  Vec3 odt_point(const Vec3& p, const Ring& r, const Vec3& fallback,
+                 const std::vector<std::array<double, 4>>& parts) const {
     Vec3 sum(0, 0, 0);
     double weight = 0;
     for (int j = 0; j < r.k; ++j) {
       if (!r.face[j].is_valid()) continue;
+      const auto& part = parts[static_cast<std::size_t>(r.face[j].idx())];
+      const double area = part[0] + part[1] + part[2];
+      if (!(area > 0)) continue;
       const Vec3 a = mesh_.point(r.ring[j]) - p, b = mesh_.point(r.ring[r.third[j]]) - p;
-      const Vec3 axb = OpenMesh::cross(a, b);
-      const double twice_area = axb.norm();
-      if (!(twice_area > 0)) continue;
-      // Circumcentre offset: (|a|² b − |b|² a) × (a × b) / (2 |a × b|²); times the area.
-      sum += OpenMesh::cross(b * a.sqrnorm() - a * b.sqrnorm(), axb) / (4 * twice_area);
-      weight += 0.5 * twice_area;
+      // Circumcentre offset: (|a|² b − |b|² a) × (a × b) / (2 |a × b|²), |a × b| = 2 area;
+      // times the area.
+      sum += OpenMesh::cross(b * a.sqrnorm() - a * b.sqrnorm(), OpenMesh::cross(a, b)) / (8 * area);
+      weight += area;
     }
     return weight > 0 ? p + sum / weight : fallback;
   }
