@@ -7,6 +7,7 @@
 #include <random>
 #include <set>
 #include <string>
+#include <type_traits>
 
 #include <gtest/gtest.h>
 
@@ -304,6 +305,21 @@ TEST(Remesh, ExtraCyclesRunWhileTheMeshStillChanges) {
   EXPECT_EQ(remesh(input, opt).report.cycles, 5);
   opt.cycles = opt.max_cycles = 0;
   EXPECT_EQ(remesh(input, opt).report.cycles, 0);
+  // A first cycle on needles may change more than all the faces (a disc cut into 200 needles
+  // around its centre: splits and collapses many times its output faces); settle_fraction 1
+  // still stops (it ran 3 cycles when it only compared the changes with the faces).
+  std::vector<Vec3> points = {{0, 0, 0}};
+  std::vector<std::array<std::uint32_t, 3>> triangles;
+  for (std::uint32_t i = 0; i < 200; ++i) {
+    const double angle = 2 * M_PI * i / 200;
+    points.push_back({std::cos(angle), std::sin(angle), 0});
+    triangles.push_back({0, 1 + i, 1 + (i + 1) % 200});
+  }
+  const Mesh needles = build_mesh(points, triangles);
+  opt.cycles = 1;
+  opt.max_cycles = 12;
+  opt.settle_fraction = 1;
+  EXPECT_EQ(remesh(needles, opt).report.cycles, 1);
 }
 
 // Islands and holes a few target lengths around keep three corners spread around them. A
@@ -341,6 +357,22 @@ struct Lcg {
   }
 };
 
+// The faces of `base` kept with probability `keep` each (one draw per face, in face order), as a
+// soup over `points`, through the loader's repair (islands, strips, holes, cracks whose pinches
+// it splits).
+Mesh thinned(const Mesh& base, const std::vector<Vec3>& points, double keep, Lcg& next) {
+  PolygonSoup soup;
+  soup.points = points;
+  for (auto f : base.faces()) {
+    const auto fv = face_vertices(base, f);
+    if (next() < keep)
+      soup.add_triangle(static_cast<std::uint32_t>(fv[0].idx()),
+                        static_cast<std::uint32_t>(fv[1].idx()),
+                        static_cast<std::uint32_t>(fv[2].idx()));
+  }
+  return repair_soup(soup).mesh;
+}
+
 // Remeshes `trials` random thinnings and checks every output: no flat face, every location on
 // its point. Trial t thins make(t) = {mesh, cells across}, its points moved by move(p) (drawn
 // first), each face kept with probability keep_min + (1 - keep_min) × a draw, after the
@@ -352,17 +384,9 @@ void expect_sound_thinnings(Lcg& next, int trials, Make make, Move move, double 
                             double length_span, int features_every) {
   for (int trial = 0; trial < trials; ++trial) {
     const auto [base, cells] = make(trial);
-    PolygonSoup soup;
-    for (auto v : base.vertices()) soup.points.push_back(move(base.point(v)));
-    const double keep = keep_min + (1 - keep_min) * next();
-    for (auto f : base.faces()) {
-      const auto fv = face_vertices(base, f);
-      if (next() < keep)
-        soup.add_triangle(static_cast<std::uint32_t>(fv[0].idx()),
-                          static_cast<std::uint32_t>(fv[1].idx()),
-                          static_cast<std::uint32_t>(fv[2].idx()));
-    }
-    const Mesh input = repair_soup(soup).mesh;
+    std::vector<Vec3> points;
+    for (auto v : base.vertices()) points.push_back(move(base.point(v)));
+    const Mesh input = thinned(base, points, keep_min + (1 - keep_min) * next(), next);
     RemeshOptions opt;
     opt.target_length = (0.3 + length_span * next()) / cells;
     opt.feature_angle_deg = trial % features_every == 0 ? 30 : 0;
@@ -428,23 +452,15 @@ TEST(Remesh, ThinnedMeshesGiveNoFlatFacesAfterTheExtraCycles) {
     const Mesh base = type == 0   ? make_grid(8 + trial % 13, 8 + trial % 11, 1.0, 1.0)
                       : type == 1 ? make_icosphere(2 + trial % 2, 1.0)
                                   : make_cube(3 + trial % 5, 1.0);
-    PolygonSoup soup;
     const double noise = 0.03 * next();
+    std::vector<Vec3> points;
     for (auto v : base.vertices()) {
       Vec3 p = base.point(v);
       if (type == 0) p[2] = 0.1 * std::sin(7 * p[0]) * std::cos(5 * p[1]);
       for (int k = 0; k < 3; ++k) p[k] += noise * (next() - 0.5) * 0.1;
-      soup.points.push_back(p);
+      points.push_back(p);
     }
-    const double keep = 0.4 + 0.6 * next();
-    for (auto f : base.faces()) {
-      const auto fv = face_vertices(base, f);
-      if (next() < keep)
-        soup.add_triangle(static_cast<std::uint32_t>(fv[0].idx()),
-                          static_cast<std::uint32_t>(fv[1].idx()),
-                          static_cast<std::uint32_t>(fv[2].idx()));
-    }
-    const Mesh input = repair_soup(soup).mesh;
+    const Mesh input = thinned(base, points, 0.4 + 0.6 * next(), next);
     if (input.n_faces() == 0) continue; // no length drawn then
     RemeshOptions opt;
     opt.target_length = mean_edge_length(input) * (0.3 + 2.5 * next());
@@ -795,53 +811,26 @@ TEST(Remesh, FeatureLinesShorterThanTheTargetLengthAreDropped) {
 
 TEST(Remesh, RejectsBadOptions) {
   const Mesh input = make_icosphere(1);
-  RemeshOptions opt;
-  opt.lambda = 0;
-  EXPECT_THROW(remesh(input, opt), InvalidArgument);
-  opt = {};
-  opt.target_length = std::nan("");
-  EXPECT_THROW(remesh(input, opt), InvalidArgument);
-  opt = {};
-  opt.cycles = -1;
-  EXPECT_THROW(remesh(input, opt), InvalidArgument);
-  opt = {};
-  opt.equalize_guard_deg = 60;
-  EXPECT_THROW(remesh(input, opt), InvalidArgument);
-  opt.equalize_guard_deg = std::nan("");
-  EXPECT_THROW(remesh(input, opt), InvalidArgument);
-  opt.equalize_guard_deg = 30;
-  opt.boundary_spacing = 1.5;
-  EXPECT_THROW(remesh(input, opt), InvalidArgument);
-  opt.boundary_spacing = std::nan("");
-  EXPECT_THROW(remesh(input, opt), InvalidArgument);
-  opt.boundary_spacing = 1.2;
-  for (double angle : {-1.0, 180.0, std::nan("")}) {
-    opt.feature_angle_deg = angle;
-    EXPECT_THROW(remesh(input, opt), InvalidArgument) << angle;
-  }
-  opt.feature_angle_deg = 0;
-  for (double weight : {-1.0, std::nan(""), HUGE_VAL}) {
-    opt.equalize_smoothing = weight;
-    EXPECT_THROW(remesh(input, opt), InvalidArgument) << weight;
-    opt.equalize_smoothing = 1.5;
-  }
-  opt.max_cycles = -1;
-  EXPECT_THROW(remesh(input, opt), InvalidArgument);
-  opt.max_cycles = 12;
-  for (double fraction : {-0.1, 1.5, std::nan("")}) {
-    opt.settle_fraction = fraction;
-    EXPECT_THROW(remesh(input, opt), InvalidArgument) << fraction;
-    opt.settle_fraction = 0.03;
-  }
-  for (double beta : {-0.1, 1.0, 2.0, std::nan("")}) {
-    opt.equalize_momentum = beta;
-    EXPECT_THROW(remesh(input, opt), InvalidArgument) << beta;
-    opt.equalize_momentum = 0.5;
-  }
-  for (double angle : {-1.0, 181.0, std::nan("")}) {
-    opt.corner_angle_deg = angle;
-    EXPECT_THROW(remesh(input, opt), InvalidArgument) << angle;
-  }
+  // Each value of a field, the other options at their defaults, must be refused.
+  auto rejects = [&input](auto RemeshOptions::*field, std::initializer_list<double> values) {
+    for (double value : values) {
+      RemeshOptions opt;
+      opt.*field = static_cast<std::remove_reference_t<decltype(opt.*field)>>(value);
+      EXPECT_THROW(remesh(input, opt), InvalidArgument) << value;
+    }
+  };
+  const double nan = std::nan("");
+  rejects(&RemeshOptions::lambda, {0.0, 1.5, nan});
+  rejects(&RemeshOptions::target_length, {nan});
+  rejects(&RemeshOptions::cycles, {-1});
+  rejects(&RemeshOptions::max_cycles, {-1});
+  rejects(&RemeshOptions::settle_fraction, {-0.1, 1.5, nan});
+  rejects(&RemeshOptions::equalize_guard_deg, {60.0, nan});
+  rejects(&RemeshOptions::boundary_spacing, {1.5, nan});
+  rejects(&RemeshOptions::feature_angle_deg, {-1.0, 180.0, nan});
+  rejects(&RemeshOptions::equalize_smoothing, {-1.0, nan, HUGE_VAL});
+  rejects(&RemeshOptions::equalize_momentum, {-0.1, 1.0, 2.0, nan});
+  rejects(&RemeshOptions::corner_angle_deg, {-1.0, 181.0, nan});
   EXPECT_THROW(remesh(Mesh()), InvalidArgument);
 }
 

@@ -238,13 +238,15 @@ public:
       timed("collapse", [&] { report.collapses += collapse_short_edges(); });
       timed("flip", [&] { report.flips += equalize_valences(); });
       const std::size_t changes = report.splits + report.collapses + report.flips - before;
+      const bool last = cycle + 1 >= max_cycles ||
+                        (cycle + 1 >= options_.cycles &&
+                         (options_.settle_fraction >= 1 ||
+                          static_cast<double>(changes) <=
+                              options_.settle_fraction * static_cast<double>(live_faces_)));
       timed("smooth", [&] { tangential_smoothing(); });
       report.cycles = cycle + 1;
-      if (cycle == 0 && max_cycles > 1) timed("reorder", [&] { compact(); });
-      if (cycle + 1 >= options_.cycles &&
-          static_cast<double>(changes) <=
-              options_.settle_fraction * static_cast<double>(live_faces_))
-        break;
+      if (last) break;
+      if (cycle == 0) timed("reorder", [&] { compact(); });
     }
     timed("reorder", [&] { compact(); });
     timed("repair", [&] { report.repairs += repair_bad_triangles(options_.repair_angle_deg); });
@@ -2058,8 +2060,8 @@ private:
   // by their areas, the vertex update of the optimal Delaunay triangulation energy (Chen & Xu
   // 2004; Alliez et al. 2005). A face's weight × its circumcentre's offset from p is bounded
   // (area × circumradius = the product of its sides / 4), so slivers do not throw it far;
-  // `fallback` (the centroid) when the faces have no area.
-  // `parts` holds each face's mixed-area parts at the current positions: they sum to its area.
+  // `fallback` (the centroid) when the faces have no area. `parts` holds each face's mixed-area
+  // parts at the current positions (equalize_areas_newton's face_data_): they sum to its area.
   Vec3 odt_point(const Vec3& p, const Ring& r, const Vec3& fallback,
                  const std::vector<std::array<double, 4>>& parts) const {
     Vec3 sum(0, 0, 0);
