@@ -581,7 +581,8 @@ int main(int argc, char** argv) {
                         {"load_average_start", number_or_null(load_before)},
                         {"load_average_end", number_or_null(load_average())},
                         {"threads_ours", args.threads},
-                        {"cycles", args.cycles},
+                        // null: each mesh's own count (as many as Remora's defaults ran)
+                        {"cycles", args.cycles > 0 ? nlohmann::json(args.cycles) : nullptr},
                         {"equalize_iterations", remora::RemeshOptions{}.equalize_iterations},
                         {"length_factor", kLengthFactor},
                         {"repeat", args.repeat},

@@ -214,6 +214,7 @@ public:
     cos_guard_ = std::cos(guard_rad_);
     hi_ = 4.0 / 3.0 * length_;
     hi2_ = hi_ * hi_;
+    flat_cross_ = 1e-6 * length_ * length_;
 
     const bool figures = options_.compute_report;
     if (figures)
@@ -1371,7 +1372,7 @@ private:
       // up to 8/3 l. A face across a crack of the input (two boundary vertices on one side, one
       // on the other, all on the crack's line, next to its tip) had no other way out: there a
       // curve vertex goes into the tip.
-      if (face_cross(f).norm() <= 1e-6 * length_ * length_) {
+      if (face_cross(f).norm() <= flat_cross_) {
         bool done = false;
         for (int k : {(shortest + 1) % 3, (shortest + 2) % 3})
           if (!done && try_collapse(mesh_.edge_handle(hs[k]), Collapse::Repair)) {
@@ -1459,11 +1460,10 @@ private:
     const Vec3 n_old = OpenMesh::cross(pa - pb, pc - pb) + OpenMesh::cross(pb - pa, pd - pa);
     const Vec3 n1 = OpenMesh::cross(pc - pa, pd - pa);
     const Vec3 n2 = OpenMesh::cross(pb - pc, pd - pc);
-    // No new face flat by the repair's measure (|cross| <= 1e-6 l²): where boundary vertices of
-    // a thinned input coincide to 1e-4 l, a flip made a face whose corners all sat there (19 of
+    // No new face flat by the repair's measure (flat_cross_): where boundary vertices of a
+    // thinned input coincide to 1e-4 l, a flip made a face whose corners all sat there (19 of
     // 3,000 thinned meshes at 12 cycles, 1 at 7; 1e-12 × (4/3 l)² let them through).
-    const double flat = 1e-6 * length_ * length_;
-    if (n1.norm() <= flat || n2.norm() <= flat) return false;
+    if (n1.norm() <= flat_cross_ || n2.norm() <= flat_cross_) return false;
     return OpenMesh::dot(n1, n_old) > 0 && OpenMesh::dot(n2, n_old) > 0 &&
            OpenMesh::dot(n1, n2) > 0.5 * n1.norm() * n2.norm();
   }
@@ -2126,6 +2126,7 @@ private:
   // Edges that flips leave alone and collapses keep on their curve.
   bool on_curve(EdgeHandle e) const { return mesh_.is_boundary(e) || feature(e); }
   double length_ = 0, lo2_ = 0, hi_ = 0, hi2_ = 0;
+  double flat_cross_ = 0; // |cross| of a face at or below this is flat: 1e-6 l² (repair, flips)
   double guard_rad_ = 0, cos_guard_ = 1; // cosine of equalize_guard_deg
   std::size_t guarded_ = 0;              // moves the guard halved or dropped
   std::size_t max_faces_ = 0;
