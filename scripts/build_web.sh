@@ -4,18 +4,44 @@
 # missing: `npm ci` from web/package-lock.json). No CDN: the page works offline.
 #
 #   scripts/build_web.sh OUT_DIR
+#
+# The registry is reached over the network, which fails now and then (a CI run once stopped on
+# npm's EIDLETIMEOUT after a connection hung for npm's default 5 minutes): npm gives up on a
+# silent connection after 60 s and retries each request itself, and the whole `npm ci` is tried
+# up to REMORA_NPM_ATTEMPTS times (default 3) with a growing pause before the build gives up.
 set -euo pipefail
 out=${1:?usage: scripts/build_web.sh OUT_DIR}
 here=$(cd "$(dirname "$0")/.." && pwd)
 web="$here/web"
+attempts=${REMORA_NPM_ATTEMPTS:-3}
 
-if [ ! -f "$web/node_modules/three/build/three.module.js" ]; then
+installed() {
+  [ -f "$web/node_modules/three/build/three.module.js" ] &&
+    [ -f "$web/node_modules/playwright-core/package.json" ]
+}
+
+if ! installed; then
   if ! command -v npm >/dev/null; then
     echo "build_web: npm is missing; run scripts/bootstrap.sh --web (installs nodejs and npm)" >&2
     exit 1
   fi
-  echo "build_web: installing three.js and playwright-core with npm ci"
-  (cd "$web" && npm ci --no-audit --no-fund --loglevel=error)
+  pause=10
+  for ((i = 1; i <= attempts; i++)); do
+    echo "build_web: installing three.js and playwright-core with npm ci (attempt $i of $attempts)"
+    if (cd "$web" && npm ci --no-audit --no-fund --loglevel=error --fetch-retries=3 \
+      --fetch-retry-mintimeout=2000 --fetch-retry-maxtimeout=20000 --fetch-timeout=60000); then
+      break
+    fi
+    if [ "$i" -eq "$attempts" ]; then
+      echo "build_web: npm ci failed $attempts times: the npm registry is unreachable from" \
+        "this machine; check the network (or a proxy: npm config get registry)" \
+        "and run make again" >&2
+      exit 1
+    fi
+    echo "build_web: npm ci failed; trying again in $pause s" >&2
+    sleep "$pause"
+    pause=$((pause * 3))
+  done
 fi
 
 mkdir -p "$out/three/build" "$out/three/examples/jsm/controls"
