@@ -55,7 +55,7 @@ struct RemeshOptions {
   int max_cycles = 12;
   /// An extra cycle runs while the last cycle's splits, collapses and valence flips together
   /// exceed this fraction of the faces. In [0, 1]; 1 never adds a cycle (a first cycle on
-  /// needles may change more than all the faces: conrod.stl 191 %).
+  /// needles may change more than all the faces: conrod.stl 313 %).
   double settle_fraction = 0.03;
   /// Iterations of the area-equalizing fine-tuning (§4); 0 skips it. With the momentum below the
   /// figures swing for a few iterations before they settle: 9 is the first count from which on
