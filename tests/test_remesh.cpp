@@ -1087,9 +1087,9 @@ TEST(RemeshBlade, NoFlatFacesAfterTenCycles) {
 
 // featuretype.STL, a coarse CAD tessellation (3,476 faces, 74 % needles, a third of its edges
 // creases sharper than 30 degrees), meets every goal of docs/remesh.md's table. Its cycles keep
-// reconnecting around the creases: the extra cycles (11 here) take its mean |θ−60°| under 7°
-// (7.23° at 7 cycles), and the fine-tuning's pull towards the ODT point keeps 99 % of its edges
-// in the band (98.8 % with the centroid at its μ of 1.5, the same cycles).
+// reconnecting around the creases: the extra cycles (10 here) take its mean |θ−60°| under 7°
+// (7.07° at 7 cycles), and the fine-tuning's pull towards the ODT point keeps 99 % of its edges
+// in the band (99.1 %; 98.6 % with the centroid at its μ of 1.5, the same cycles).
 TEST(RemeshFeaturetype, MeetsEveryGoalWithTheExtraCyclesAndTheOdtTarget) {
   const std::string path = shared_mesh("cad/featuretype.STL");
   if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " not present";
