@@ -33,9 +33,9 @@ if ! installed; then
       break
     fi
     if [ "$i" -eq "$attempts" ]; then
-      echo "build_web: npm ci failed $attempts times: the npm registry is unreachable from" \
-        "this machine; check the network (or a proxy: npm config get registry)" \
-        "and run make again" >&2
+      echo "build_web: npm ci failed $attempts times (its errors are above); most often the" \
+        "npm registry is unreachable from this machine: check the network (or a proxy:" \
+        "npm config get registry) and run make again" >&2
       exit 1
     fi
     echo "build_web: npm ci failed; trying again in $pause s" >&2
