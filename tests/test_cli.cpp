@@ -206,6 +206,23 @@ TEST_F(Cli, RemeshLowPassRemeshesTheSmoothedSurface) {
             2);
 }
 
+// The filter's feature cap reaches the command line: on a torus whose tube is thinner than σ
+// every vertex is capped by default, none with --low-pass-cap 0, and a negative cap is refused.
+TEST_F(Cli, RemeshLowPassCapsThinParts) {
+  const fs::path in = dir_ / "torus.off", out = dir_ / "torus_out.obj";
+  write_mesh(in.string(), make_torus(120, 12, 2.0, 0.2));
+  const std::string base = "remesh " + in.string() + " -o " + out.string() + " --low-pass 2 ";
+  const CliRun capped = run(base + "--json");
+  ASSERT_EQ(capped.exit_code, 0) << capped.err;
+  const auto j = nlohmann::json::parse(capped.out);
+  EXPECT_EQ(j["low_pass"]["sigma_capped_vertices"], 120 * 12);
+  EXPECT_NEAR(j["low_pass"]["sigma_min"].get<double>(), 0.2, 0.002);
+  const CliRun plain = run(base + "--low-pass-cap 0 --json");
+  ASSERT_EQ(plain.exit_code, 0) << plain.err;
+  EXPECT_EQ(nlohmann::json::parse(plain.out)["low_pass"]["sigma_capped_vertices"], 0);
+  EXPECT_EQ(run(base + "--low-pass-cap -1").exit_code, 2);
+}
+
 TEST_F(Cli, RemeshRejectsBadOptionsBeforeWorking) {
   const fs::path in = dir_ / "sphere.off";
   write_mesh(in.string(), make_icosphere(1));
@@ -325,6 +342,11 @@ TEST_F(Cli, EditRefusesBadRequestsAndWritesNothing) {
        "--translate"},
       {"--support-sphere 0,0,1,0.8 --handle-sphere 0,0,1 --translate 1,0,0", 1,
        "--handle-sphere: expected 4 numbers"},
+      {"--support-sphere 0,0,1,0.8 --handle-sphere 0,0,1,0.2 --base-feature-cap -1", 2,
+       "--base-feature-cap"},
+      {"--edit " +
+           write("cap.json", R"({"support": [1, 2], "base_feature_cap": -1, )" + ok_handles + "}"),
+       1, "edit.base_feature_cap: must be >= 0"},
       {"--support-sphere 0,0,1,0.8", 2, "requires"},
       {"", 1, "nothing to edit"},
       {"--support-sphere 0,0,1,0.8 --handle-sphere 0,0,1,0.2 --solver ldlt --areas mixed", 1,

@@ -28,7 +28,7 @@ std::string error_of(const json& j) {
 TEST(EditRequest, ParsesEveryRegionAndTransformForm) {
   const json j = json::parse(R"({
     "k": 3, "solver": "ldlt", "areas": "mixed-symmetric", "details": "none", "remesh": false,
-    "base_smoothing": 1.5,
+    "base_smoothing": 1.5, "base_feature_cap": 0.5,
     "support": {"union": [[1, 2, 3], {"box": {"min": [0, 0, 0], "max": [1, 1, 1]}},
                           {"geodesic": {"vertex": 5, "radius": 0.5}}]},
     "handles": [
@@ -53,6 +53,7 @@ TEST(EditRequest, ParsesEveryRegionAndTransformForm) {
   EXPECT_EQ(o.details, DetailMode::None);
   EXPECT_FALSE(o.remesh);
   EXPECT_EQ(o.base.smoothing, 1.5);
+  EXPECT_EQ(o.base.feature_cap, 0.5);
   // Scale 2 about the center c = (1, 0, 0), then 90° about z through c, then +x: the point
   // (2, 0, 0) -> (3, 0, 0) -> (1, 2, 0) -> (2, 2, 0).
   const Transform t = resolve_transform(r.handles[0].transform, Eigen::Vector3d(1, 0, 0));

@@ -8,6 +8,7 @@
 #include "remora/geometry/intrinsic.h"
 #include "remora/geometry/laplacian.h"
 #include "remora/geometry/measures.h"
+#include "remora/geometry/thickness.h"
 #include "remora/linalg/kharmonic.h"
 #include "remora/mesh/primitives.h"
 #include "remora/multires/base_surface.h"
@@ -162,6 +163,114 @@ TEST(LowPass, KeepsAPlanesBoundaryAndSmoothsAlongIt) {
   ASSERT_GT(noise_in, 0.009);
   // The curve filter's factor for this wavelength, 1 / (1 + (2πσ/λ)²), is about 0.05.
   EXPECT_LT(noise_out, 0.15 * noise_in);
+}
+
+Eigen::MatrixXd points_of(const Mesh& m) {
+  Eigen::MatrixXd x(static_cast<Eigen::Index>(m.n_vertices()), 3);
+  for (const VertexHandle v : m.vertices())
+    for (int k = 0; k < 3; ++k) x(v.idx(), k) = m.point(v)[k];
+  return x;
+}
+
+// The tube of a thin torus is a circle mode of the filter: one step scales its radius r by
+// 1 / (1 + c²) with c = σ / r, or with the cap c = min(σ / r, feature_cap). Uncapped (σ = 1.19 r)
+// the tube keeps 42 % of its radius, capped at 1 half, at 0.5 four fifths.
+TEST(LowPass, FeatureCapKeepsAThinTubeAtOneOverOnePlusCapSquared) {
+  const double big = 2.0, small = 0.2;
+  const Mesh torus = make_torus(120, 12, big, small);
+  const Eigen::MatrixXd x = points_of(torus);
+  for (const double cap : {0.0, 0.5, 1.0}) {
+    LowPassFilter filter(torus, {.smoothing = 2.0, .feature_cap = cap});
+    const double sigma = filter.stats().sigma;
+    ASSERT_GT(sigma, small); // thinner than the filter: the cap has something to do
+    const Eigen::MatrixXd y = filter.apply(x);
+    double centre = 0, tube = 0;
+    for (Eigen::Index i = 0; i < y.rows(); ++i) centre += std::hypot(y(i, 0), y(i, 1));
+    centre /= static_cast<double>(y.rows());
+    for (Eigen::Index i = 0; i < y.rows(); ++i)
+      tube += std::hypot(std::hypot(y(i, 0), y(i, 1)) - centre, y(i, 2));
+    tube /= static_cast<double>(y.rows());
+    const double c = cap > 0 ? std::min(sigma / small, cap) : sigma / small;
+    EXPECT_NEAR(tube / small, 1.0 / (1.0 + c * c), 0.03) << "cap " << cap;
+    EXPECT_NEAR(centre, big, 0.03 * big) << "cap " << cap;
+    if (cap > 0) {
+      // Every vertex sees the tube's diameter (chords: within 1 %).
+      EXPECT_EQ(filter.stats().capped, torus.n_vertices());
+      EXPECT_NEAR(filter.stats().sigma_min, cap * small, 0.01 * cap * small);
+    } else {
+      EXPECT_EQ(filter.stats().capped, 0u);
+      EXPECT_EQ(filter.stats().sigma_min, sigma);
+    }
+  }
+}
+
+// A boundary loop is capped by its own radius: the small hole of an annulus (radius 0.03, σ
+// about 7 times that) all but closes without the cap and keeps 1 / (1 + cap²) of its radius
+// with it; the outer rim (radius 1) is filtered as before.
+TEST(LowPass, FeatureCapKeepsASmallHoleOpen) {
+  const double inner = 0.03;
+  const int segments = 24, rings = 20;
+  const Mesh annulus = make_annulus(rings, segments, inner, 1.0);
+  const Eigen::MatrixXd x = points_of(annulus);
+  Eigen::MatrixXd uncapped;
+  for (const double cap : {0.0, 0.5, 1.0}) {
+    LowPassFilter filter(annulus, {.smoothing = 2.0, .feature_cap = cap});
+    const Eigen::MatrixXd y = filter.apply(x);
+    double hole = 0;
+    for (int s = 0; s < segments; ++s) hole += std::hypot(y(s, 0), y(s, 1)) / segments;
+    const double c = cap > 0 ? cap : filter.stats().sigma / inner;
+    EXPECT_NEAR(hole / inner, 1.0 / (1.0 + c * c), 0.03) << "cap " << cap;
+    EXPECT_EQ(filter.stats().capped_loops, cap > 0 ? 1u : 0u); // the hole, not the rim
+    if (cap == 0) {
+      uncapped = y;
+    } else {
+      for (int s = 0; s < segments; ++s) {
+        const Eigen::Index i = rings * segments + s; // the outer rim
+        EXPECT_LT((y.row(i) - uncapped.row(i)).norm(), 1e-12);
+      }
+    }
+  }
+}
+
+// A part thicker than 2σ / cap everywhere is filtered exactly as without the cap.
+TEST(LowPass, FeatureCapLeavesAThickPartAlone) {
+  for (const Mesh& m : {make_torus(96, 24, 1.0, 0.5), make_icosphere(3, 1.0)}) {
+    const Eigen::MatrixXd x = points_of(m);
+    LowPassFilter capped(m, {.smoothing = 2.0, .feature_cap = 1.0});
+    LowPassFilter plain(m, {.smoothing = 2.0, .feature_cap = 0.0});
+    EXPECT_EQ(capped.stats().capped, 0u);
+    EXPECT_EQ(capped.apply(x), plain.apply(x));
+  }
+}
+
+// The field: at most σ, at most cap × the half-width, and nowhere steeper than cap_slope along
+// an edge; on a fat torus (hole radius 0.2) the cap bites around the hole only.
+TEST(LowPass, SmoothingFieldIsCappedAndLipschitz) {
+  const Mesh torus = make_torus(60, 48, 1.0, 0.8);
+  const double sigma = 0.3;
+  const Eigen::VectorXd half = vertex_half_widths(torus);
+  for (const double slope : {0.5, 1.0, 4.0}) {
+    const LowPassOptions options{.feature_cap = 1.0, .cap_slope = slope};
+    const Eigen::VectorXd field = smoothing_field(torus, sigma, options);
+    std::size_t capped = 0;
+    for (const VertexHandle v : torus.vertices()) {
+      const double f = field[v.idx()];
+      EXPECT_LE(f, sigma);
+      EXPECT_LE(f, half[v.idx()] * (1 + 1e-12));
+      capped += f < sigma ? 1 : 0;
+      for (const VertexHandle w : torus.vv_range(v))
+        EXPECT_LE(std::abs(f - field[w.idx()]),
+                  slope * (torus.point(v) - torus.point(w)).norm() * (1 + 1e-12));
+    }
+    EXPECT_NEAR(field.minCoeff(), 0.2, 0.002); // the hole's radius
+    EXPECT_GT(capped, 0u);
+    EXPECT_LT(capped, torus.n_vertices() / 2);
+  }
+  EXPECT_TRUE((smoothing_field(torus, sigma, {.feature_cap = 0.0}).array() == sigma).all());
+  EXPECT_THROW(smoothing_field(torus, -1.0, {}), InvalidArgument);
+  EXPECT_THROW(smoothing_field(torus, sigma, {.feature_cap = -1.0}), InvalidArgument);
+  EXPECT_THROW(smoothing_field(torus, sigma, {.cap_slope = 0.0}), InvalidArgument);
+  EXPECT_THROW(LowPassFilter(torus, {.feature_cap = std::nan("")}), InvalidArgument);
 }
 
 } // namespace

@@ -221,6 +221,39 @@ TEST(PrimitivesCube, CountsSurfaceAreaVolumeAndOrientation) {
   }
 }
 
+TEST(PrimitivesTorus, CountsOnTheTubeOutwardGenusOneAndVolume) {
+  const double big = 2.0, small = 0.5;
+  double previous_gap = std::numeric_limits<double>::infinity();
+  for (const int k : {8, 16, 32}) {
+    const Mesh mesh = make_torus(2 * k, k, big, small);
+    ASSERT_EQ(mesh.n_vertices(), static_cast<std::size_t>(2 * k * k));
+    ASSERT_EQ(mesh.n_faces(), static_cast<std::size_t>(4 * k * k));
+    // Euler characteristic 0, closed: genus 1.
+    const auto chi = static_cast<long>(mesh.n_vertices()) - static_cast<long>(mesh.n_edges()) +
+                     static_cast<long>(mesh.n_faces());
+    EXPECT_EQ(chi, 0);
+    EXPECT_EQ(boundary_halfedges(mesh), 0u);
+    // Every vertex lies on the tube: at distance r from the centre circle.
+    for (const VertexHandle v : mesh.vertices()) {
+      const Vec3& p = mesh.point(v);
+      EXPECT_NEAR(std::hypot(std::hypot(p[0], p[1]) - big, p[2]), small, 1e-14);
+    }
+    // Outward: each face's normal points away from the tube's centre circle.
+    for (const FaceHandle f : mesh.faces()) {
+      const Vec3 c = centroid(mesh, f);
+      const double rho = std::hypot(c[0], c[1]);
+      const Vec3 axis(c[0] * big / rho, c[1] * big / rho, 0.0);
+      EXPECT_GT(area_normal(mesh, f) | (c - axis), 0.0);
+    }
+    // The inscribed polyhedron's volume approaches 2 pi^2 R r^2 from below.
+    const double gap = 2 * kPi * kPi * big * small * small - signed_volume(mesh);
+    EXPECT_GT(gap, 0.0);
+    EXPECT_LT(gap, previous_gap);
+    previous_gap = gap;
+  }
+  EXPECT_LT(previous_gap, 0.01 * 2 * kPi * kPi * big * small * small);
+}
+
 bool same_bits(const Mesh& a, const Mesh& b) {
   if (a.n_vertices() != b.n_vertices() || a.n_faces() != b.n_faces()) return false;
   for (const VertexHandle v : a.vertices()) {
@@ -243,6 +276,7 @@ TEST(PrimitivesDeterminism, TheSameArgumentsGiveTheSameMeshBitForBit) {
   EXPECT_TRUE(same_bits(make_annulus(2, 9, 0.3, 1.0), make_annulus(2, 9, 0.3, 1.0)));
   EXPECT_TRUE(same_bits(make_icosphere(3, 1.5), make_icosphere(3, 1.5)));
   EXPECT_TRUE(same_bits(make_cube(3, 2.0), make_cube(3, 2.0)));
+  EXPECT_TRUE(same_bits(make_torus(9, 5, 2.0, 0.5), make_torus(9, 5, 2.0, 0.5)));
 }
 
 TEST(PrimitivesArguments, InvalidArgumentsThrow) {
@@ -266,6 +300,11 @@ TEST(PrimitivesArguments, InvalidArgumentsThrow) {
   EXPECT_THROW(make_icosphere(1, 0.0), InvalidArgument);
   EXPECT_THROW(make_cube(0, 1.0), InvalidArgument);
   EXPECT_THROW(make_cube(2, nan), InvalidArgument);
+  EXPECT_THROW(make_torus(2, 8, 2.0, 0.5), InvalidArgument);
+  EXPECT_THROW(make_torus(8, 2, 2.0, 0.5), InvalidArgument);
+  EXPECT_THROW(make_torus(8, 8, 1.0, 1.0), InvalidArgument);
+  EXPECT_THROW(make_torus(8, 8, 2.0, 0.0), InvalidArgument);
+  EXPECT_THROW(make_torus(8, 8, inf, 0.5), InvalidArgument);
 }
 
 } // namespace

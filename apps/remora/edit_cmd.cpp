@@ -88,6 +88,9 @@ void print_edit_report(std::ostream& os, const EditReport& r, double load_ms, do
                                : std::string("not remeshed"),
                     grouped(r.base_vertices), grouped(r.base_faces), r.sigma,
                     grouped(r.intrinsic_flips), grouped(r.input_negative_weights));
+  if (r.sigma_capped_vertices + r.sigma_capped_loops > 0)
+    os << "base filter: "
+       << capped_sigma_line(r.sigma_capped_vertices, r.sigma_min, r.sigma_capped_loops) << "\n";
   os << fmt::format("base quality: min angle {:.2f} deg, mean |theta-60| {:.2f} deg, mixed area "
                     "rel MAD {:.4f}, Laplacian symmetry defect {:.4f}\n",
                     r.base_quality.angles.min_deg,
@@ -136,7 +139,7 @@ void add_edit_command(CLI::App& app) {
     std::string support_sphere, handle_sphere, translate, rotate, scale;
     int k = 0, threads = 0;
     std::string solver, areas, details;
-    double base_smoothing = -1, length_factor = -1;
+    double base_smoothing = -1, base_feature_cap = -1, length_factor = -1;
     bool no_remesh = false, report = false, json = false;
   };
   auto a = std::make_shared<Args>();
@@ -171,6 +174,10 @@ void add_edit_command(CLI::App& app) {
   cmd->add_option("--base-smoothing", a->base_smoothing,
                   "Low-pass length of the base surface, in mean edge lengths (area-based on needle "
                   "meshes; default 2)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--base-feature-cap", a->base_feature_cap,
+                  "The base filter's sigma at most this many times the part's local half-width, "
+                  "so thin tubes and small holes are not pinched (default 1; 0 = off)")
       ->check(CLI::NonNegativeNumber);
   cmd->add_option("--length-factor", a->length_factor,
                   "Base remesh edge length = factor x the mean edge length (area-based on needle "
@@ -231,6 +238,7 @@ void add_edit_command(CLI::App& app) {
     if (!a->areas.empty()) options.system.areas = parse_area_weights(a->areas);
     if (!a->details.empty()) options.details = parse_detail_mode(a->details);
     if (a->base_smoothing >= 0) options.base.smoothing = a->base_smoothing;
+    if (a->base_feature_cap >= 0) options.base.feature_cap = a->base_feature_cap;
     if (a->length_factor > 0) options.remesh_options.length_factor = a->length_factor;
     if (a->no_remesh) options.remesh = false;
     options.threads = a->threads;

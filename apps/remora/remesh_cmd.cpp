@@ -1,6 +1,7 @@
 #include <chrono>
 #include <cstdio>
 #include <iostream>
+#include <optional>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -91,6 +92,7 @@ void add_remesh_command(CLI::App& app) {
     std::string in, out;
     RemeshOptions options; ///< the library's defaults until a flag says otherwise
     double low_pass = 0;   ///< σ of the base-surface filter, in mean edge lengths; 0 = off
+    LowPassOptions filter; ///< the editor's filter defaults but for the strength
     std::string method = "newton";
     std::string smoothing_target = "odt";
     bool no_project = false, report = false, json = false;
@@ -178,13 +180,23 @@ void add_remesh_command(CLI::App& app) {
                   "Remesh the low-pass filtered surface instead, as `remora edit` builds its base "
                   "(sigma in mean edge lengths; the editor's default is 2)")
       ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--low-pass-cap", a->filter.feature_cap,
+                  "With --low-pass: sigma at most this many times the part's local half-width, so "
+                  "thin tubes and small holes are not pinched (0 = one sigma everywhere)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   cmd->callback([a] {
     format_from_path(a->out); // fail on an unknown extension before the long work
     LoadResult loaded = read_mesh(a->in);
+    std::optional<LowPassStats> low_pass;
     if (a->low_pass > 0) {
       // The editor's base surface S (multires/base_surface.h): same connectivity, smooth points.
-      LowPassFilter filter(loaded.mesh, {.smoothing = a->low_pass});
+      LowPassOptions filter_options = a->filter;
+      filter_options.smoothing = a->low_pass;
+      filter_options.threads = a->options.threads;
+      LowPassFilter filter(loaded.mesh, filter_options);
       set_positions(loaded.mesh, filter.apply(positions_matrix(loaded.mesh)));
+      low_pass = filter.stats();
     }
     RemeshOptions options = a->options;
     options.equalization = a->method == "gravity" ? Equalization::Gravity : Equalization::Newton;
@@ -202,9 +214,21 @@ void add_remesh_command(CLI::App& app) {
     if (a->json) {
       nlohmann::json j = to_json(result.report);
       j["output"] = a->out;
+      if (low_pass)
+        j["low_pass"] = {{"sigma", low_pass->sigma},
+                         {"sigma_min", low_pass->sigma_min},
+                         {"sigma_capped_vertices", low_pass->capped},
+                         {"sigma_capped_loops", low_pass->capped_loops}};
       std::cout << j.dump(2) << "\n";
       return;
     }
+    if (a->report && low_pass)
+      std::cout << fmt::format("low-pass filter: sigma {:.4g}", low_pass->sigma)
+                << (low_pass->capped + low_pass->capped_loops > 0
+                        ? ", " + capped_sigma_line(low_pass->capped, low_pass->sigma_min,
+                                                   low_pass->capped_loops)
+                        : std::string())
+                << "\n";
     if (a->report) print_remesh_report(std::cout, result.report);
     std::cout << "wrote " << a->out << " (" << grouped(result.mesh.n_vertices()) << " vertices, "
               << grouped(result.mesh.n_faces()) << " faces)\n";

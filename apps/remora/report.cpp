@@ -83,4 +83,15 @@ void print_quality(std::ostream& os, const MeshQuality& q) {
                   b.min[1], b.min[2], b.max[0], b.max[1], b.max[2], q.bounding_box_diagonal));
 }
 
+std::string capped_sigma_line(std::size_t vertices, double sigma_min, std::size_t loops) {
+  std::string line = "sigma lowered";
+  if (vertices > 0)
+    line +=
+        fmt::format(" at {} vertices of thin parts (down to {:.4g})", grouped(vertices), sigma_min);
+  if (loops > 0)
+    line += fmt::format("{} on {} small boundary loop{}", vertices > 0 ? " and" : "",
+                        grouped(loops), loops == 1 ? "" : "s");
+  return line;
+}
+
 } // namespace remora::cli

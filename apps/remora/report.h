@@ -46,4 +46,8 @@ private:
 void print_load_report(std::ostream& os, const LoadReport& report);
 void print_quality(std::ostream& os, const MeshQuality& quality);
 
+/// What the base filter's feature cap did (multires/base_surface.h), e.g. "sigma lowered at 868
+/// vertices of thin parts (down to 0.00084) and on 3 small boundary loops".
+std::string capped_sigma_line(std::size_t vertices, double sigma_min, std::size_t loops);
+
 } // namespace remora::cli

@@ -296,4 +296,37 @@ Mesh make_cube(int n, double size) {
   return build(points, triangles);
 }
 
+Mesh make_torus(int around, int tube, double major_radius, double minor_radius) {
+  require_count("make_torus", "around", around, 3);
+  require_count("make_torus", "tube", tube, 3);
+  require_length("make_torus", "major_radius", major_radius);
+  require_length("make_torus", "minor_radius", minor_radius);
+  if (!(minor_radius < major_radius)) {
+    throw InvalidArgument("make_torus: minor_radius = " + std::to_string(minor_radius) +
+                          " must be below major_radius = " + std::to_string(major_radius));
+  }
+  require_size("make_torus", std::int64_t{around} * tube, std::int64_t{2} * around * tube);
+
+  std::vector<Vec3> points;
+  for (int i = 0; i < around; ++i) {
+    const double u = 2.0 * std::numbers::pi * i / around;
+    for (int j = 0; j < tube; ++j) {
+      const double v = 2.0 * std::numbers::pi * j / tube;
+      const double rho = major_radius + minor_radius * std::cos(v);
+      points.emplace_back(rho * std::cos(u), rho * std::sin(u), minor_radius * std::sin(v));
+    }
+  }
+  const auto index = [around, tube](int i, int j) { return (i % around) * tube + j % tube; };
+  std::vector<Triangle> triangles;
+  for (int i = 0; i < around; ++i) {
+    for (int j = 0; j < tube; ++j) {
+      // Increasing u then v turns counter-clockwise seen from outside the tube.
+      const int a = index(i, j), b = index(i + 1, j), c = index(i + 1, j + 1), d = index(i, j + 1);
+      triangles.push_back({a, b, c});
+      triangles.push_back({a, c, d});
+    }
+  }
+  return build(points, triangles);
+}
+
 } // namespace remora

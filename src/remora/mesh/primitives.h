@@ -56,4 +56,12 @@ Mesh make_icosphere(int subdivisions, double radius = 1.0);
 /// and corners are shared. V = 6 n^2 + 2, F = 12 n^2, closed, genus 0. n >= 1.
 Mesh make_cube(int n, double size);
 
+/// A torus about the z axis: the tube's centre circle has radius `major_radius` in z = 0, the tube
+/// has radius `minor_radius`. Vertex (i, j), 0 <= i < around, 0 <= j < tube, index i tube + j, is
+/// at angle u = 2 pi i / around about z and v = 2 pi j / tube about the tube's centre, at
+/// ((R + r cos v) cos u, (R + r cos v) sin u, r sin v); each quad is split into two triangles.
+/// V = around tube, F = 2 around tube, closed, genus 1, oriented outward (away from the tube's
+/// centre). around, tube >= 3, 0 < minor_radius < major_radius.
+Mesh make_torus(int around, int tube, double major_radius, double minor_radius);
+
 } // namespace remora

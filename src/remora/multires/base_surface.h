@@ -16,6 +16,16 @@
 // inflate it: geometry/measures.h, length_scale()). A Laplacian eigenfunction of
 // wavelength λ is scaled by 1 / (1 + (2πσ/λ)²) per step: wavelengths below 2πσ lose at least half.
 // The filter is factored once (a Jacobi-preconditioned CG set-up) and applied to any positions.
+//
+// Feature cap: a tube or a hole of radius r is such a short wavelength; one step scales its
+// radius by about 1 / (1 + σ²/r²), so a hole smaller than σ closes into a neck and an arm
+// thinner than σ shrinks to a thread, which the remesher cannot line with triangles of the
+// target size and over which the Phong offsets (larger than the base's curvature radius) cross.
+// So σ varies per vertex: σ_i = min(σ, feature_cap × the vertex's half-width), the half-width
+// measured by rays across the part (geometry/thickness.h), then relaxed to the largest field
+// below that which changes by at most cap_slope per unit length along edges; an edge's weight
+// is scaled by σ_i σ_j instead of σ². A part thicker than 2σ/feature_cap everywhere is filtered
+// exactly as without the cap. docs/editing.md has what it measured.
 #pragma once
 
 #include <cstddef>
@@ -35,6 +45,12 @@ struct LowPassOptions {
   /// σ in units of length_scale() (the mean edge length on a mesh without needles); 0 turns the
   /// filter into the identity.
   double smoothing = 2.0;
+  /// σ_i <= feature_cap × half-width (above); 0 turns the cap off (one σ everywhere). At 1 a
+  /// tube or hole keeps about half its radius.
+  double feature_cap = 1.0;
+  /// How fast σ may grow again away from a capped vertex (per unit length; > 0).
+  double cap_slope = 1.0;
+  int threads = 0; ///< for the half-widths; 0 = all hardware threads
   /// Implicit steps with the same operator (a steeper cut-off).
   int steps = 1;
   /// Relative residual of every CG solve.
@@ -43,14 +59,23 @@ struct LowPassOptions {
 
 struct LowPassStats {
   double sigma = 0.0;                 ///< absolute σ
+  double sigma_min = 0.0;             ///< the smallest σ_i (σ when no vertex is capped)
+  std::size_t capped = 0;             ///< vertices whose σ_i < σ
+  std::size_t capped_loops = 0;       ///< boundary loops filtered with a σ below σ
   IntrinsicLaplacian laplacian_stats; ///< flips, clamps (weights and mass are not kept here)
   int iterations = 0; ///< CG iterations of the last apply(), the most over the columns
 };
 
+/// The filter's σ per vertex (by idx()) for an absolute σ `sigma`: the cap and its relaxation
+/// above. Without the cap, or on a part thick enough, every entry is `sigma`. Isolated vertices
+/// keep `sigma`. Throws InvalidArgument for a negative or non-finite sigma, feature_cap or a
+/// cap_slope that is not > 0.
+Eigen::VectorXd smoothing_field(const Mesh& mesh, double sigma, const LowPassOptions& options);
+
 class LowPassFilter {
 public:
   /// Builds the operator of `mesh` (its points define the metric). Throws InvalidArgument for a
-  /// negative or non-finite smoothing, or steps < 1.
+  /// negative or non-finite smoothing or feature_cap, a cap_slope that is not > 0, or steps < 1.
   LowPassFilter(const Mesh& mesh, const LowPassOptions& options = {});
   LowPassFilter(LowPassFilter&&) noexcept;
   LowPassFilter& operator=(LowPassFilter&&) noexcept;

@@ -164,7 +164,8 @@ TransformSpec parse_transform(const json& j, const std::string& path) {
 EditRequest parse_edit_request(const json& j) {
   EditRequest r;
   only_keys(j, "edit",
-            {"k", "solver", "areas", "details", "remesh", "base_smoothing", "support", "handles"});
+            {"k", "solver", "areas", "details", "remesh", "base_smoothing", "base_feature_cap",
+             "support", "handles"});
   if (j.contains("k")) {
     if (!j.at("k").is_number_integer()) fail("edit.k", "expected 1, 2 or 3");
     r.k = j.at("k").get<int>();
@@ -182,6 +183,10 @@ EditRequest parse_edit_request(const json& j) {
   if (j.contains("base_smoothing")) {
     r.base_smoothing = number(j.at("base_smoothing"), "edit.base_smoothing");
     if (*r.base_smoothing < 0) fail("edit.base_smoothing", "must be >= 0");
+  }
+  if (j.contains("base_feature_cap")) {
+    r.base_feature_cap = number(j.at("base_feature_cap"), "edit.base_feature_cap");
+    if (*r.base_feature_cap < 0) fail("edit.base_feature_cap", "must be >= 0");
   }
   r.support = parse_region(member(j, "edit", "support"), "edit.support");
   const json& handles = member(j, "edit", "handles");
@@ -295,6 +300,7 @@ void apply_request_options(const EditRequest& r, EditorOptions& o) {
   if (r.details) o.details = parse_detail_mode(*r.details);
   if (r.remesh) o.remesh = *r.remesh;
   if (r.base_smoothing) o.base.smoothing = *r.base_smoothing;
+  if (r.base_feature_cap) o.base.feature_cap = *r.base_feature_cap;
 }
 
 } // namespace remora

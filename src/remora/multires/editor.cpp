@@ -194,9 +194,14 @@ Editor::Editor(Mesh mesh, EditorOptions options) : impl_(std::make_unique<Impl>(
   // 2. The base surface S: low-pass filtered O, same connectivity.
   m.progress("base surface", 0, 1);
   auto t0 = Clock::now();
-  m.filter.emplace(m.input, m.options.base);
+  LowPassOptions filter_options = m.options.base;
+  if (filter_options.threads == 0) filter_options.threads = m.options.threads;
+  m.filter.emplace(m.input, filter_options);
   const Eigen::MatrixXd smooth = m.filter->apply(m.input_positions);
   m.report.sigma = m.filter->stats().sigma;
+  m.report.sigma_min = m.filter->stats().sigma_min;
+  m.report.sigma_capped_vertices = m.filter->stats().capped;
+  m.report.sigma_capped_loops = m.filter->stats().capped_loops;
   m.report.intrinsic_flips = m.filter->stats().laplacian_stats.flips;
   m.report.input_negative_weights = m.filter->stats().laplacian_stats.negative_before;
   Mesh s = m.input;
@@ -634,6 +639,9 @@ nlohmann::json to_json(const EditReport& r) {
                {"faces", r.base_faces},
                {"remeshed", r.remeshed},
                {"sigma", r.sigma},
+               {"sigma_min", r.sigma_min},
+               {"sigma_capped_vertices", r.sigma_capped_vertices},
+               {"sigma_capped_loops", r.sigma_capped_loops},
                {"intrinsic_flips", r.intrinsic_flips},
                {"input_negative_cotan_weights", r.input_negative_weights},
                {"target_length", r.base_target_length},

@@ -89,7 +89,10 @@ struct EditReport {
   std::size_t input_vertices = 0, input_faces = 0;
   std::size_t base_vertices = 0, base_faces = 0;
   bool remeshed = true;
-  double sigma = 0.0; ///< the low-pass filter's length scale
+  double sigma = 0.0;                    ///< the low-pass filter's length scale
+  double sigma_min = 0.0;                ///< its smallest value at a vertex (the feature cap)
+  std::size_t sigma_capped_vertices = 0; ///< vertices of O where the cap lowered it
+  std::size_t sigma_capped_loops = 0;    ///< boundary loops of O it lowered it on
   std::size_t intrinsic_flips = 0, input_negative_weights = 0;
   double base_target_length = 0.0;
   double base_symmetry_defect = 0.0; ///< laplacian_symmetry_defect() of the base

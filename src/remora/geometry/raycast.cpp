@@ -1,0 +1,214 @@
+#include "remora/geometry/raycast.h"
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "remora/common/error.h"
+#include "remora/mesh/surface_point.h"
+
+namespace remora {
+
+namespace {
+
+constexpr std::int32_t kLeafSize = 4;
+constexpr int kMaxDepth = 64; // median splits: depth <= log2(faces) + 1
+
+float down(double x) {
+  const auto f = static_cast<float>(x);
+  return static_cast<double>(f) > x ? std::nextafter(f, -std::numeric_limits<float>::infinity())
+                                    : f;
+}
+
+float up(double x) {
+  const auto f = static_cast<float>(x);
+  return static_cast<double>(f) < x ? std::nextafter(f, std::numeric_limits<float>::infinity()) : f;
+}
+
+} // namespace
+
+RayCaster::RayCaster(const Mesh& mesh) {
+  points_.resize(mesh.n_vertices());
+  for (const VertexHandle v : mesh.vertices())
+    points_[static_cast<std::size_t>(v.idx())] = mesh.point(v);
+  std::vector<Vec3> centroids;
+  faces_.reserve(mesh.n_faces());
+  centroids.reserve(mesh.n_faces());
+  for (const FaceHandle f : mesh.faces()) {
+    const auto fv = face_vertices(mesh, f);
+    const Vec3 a = mesh.point(fv[0]), b = mesh.point(fv[1]), c = mesh.point(fv[2]);
+    for (const Vec3& p : {a, b, c})
+      if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
+        throw InvalidArgument(fmt::format(
+            "ray caster: face {} has a corner that is not finite; repair the mesh first", f.idx()));
+    const Vec3 ab = b - a, ac = c - a;
+    // Zero-area faces are never met (a ray in their plane would meet them anywhere).
+    const double longest2 = std::max({ab.sqrnorm(), ac.sqrnorm(), (c - b).sqrnorm()});
+    if (!(OpenMesh::cross(ab, ac).sqrnorm() > 1e-30 * longest2 * longest2)) continue;
+    faces_.push_back({{fv[0].idx(), fv[1].idx(), fv[2].idx()}, f.idx()});
+    centroids.push_back((a + b + c) / 3.0);
+  }
+  if (faces_.empty()) return;
+  std::vector<std::int32_t> order(faces_.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = static_cast<std::int32_t>(i);
+  nodes_.reserve(2 * faces_.size() / kLeafSize + 1);
+  build(order, centroids, 0, static_cast<std::int32_t>(order.size()));
+  std::vector<Face> sorted;
+  sorted.reserve(faces_.size());
+  for (const std::int32_t i : order) sorted.push_back(faces_[static_cast<std::size_t>(i)]);
+  faces_ = std::move(sorted);
+}
+
+// Builds the subtree over order[begin, end) (indices into faces_ and centroids) below a new
+// node: leaves take their bounds from their faces, inner nodes the union of their children's, so
+// every face is read once.
+void RayCaster::build(std::vector<std::int32_t>& order, const std::vector<Vec3>& centroids,
+                      std::int32_t begin, std::int32_t end) {
+  const auto self = nodes_.size();
+  nodes_.push_back({});
+  double lo[3], hi[3];
+  for (int k = 0; k < 3; ++k) {
+    lo[k] = std::numeric_limits<double>::infinity();
+    hi[k] = -std::numeric_limits<double>::infinity();
+  }
+  for (std::int32_t i = begin; i < end; ++i) {
+    const Vec3& c = centroids[static_cast<std::size_t>(order[static_cast<std::size_t>(i)])];
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = std::min(lo[k], c[k]);
+      hi[k] = std::max(hi[k], c[k]);
+    }
+  }
+  int axis = 0;
+  for (int k = 1; k < 3; ++k)
+    if (hi[k] - lo[k] > hi[axis] - lo[axis]) axis = k;
+  if (end - begin <= kLeafSize || !(hi[axis] > lo[axis])) {
+    Node& node = nodes_[self];
+    node.first = begin;
+    node.count = end - begin;
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = std::numeric_limits<double>::infinity();
+      hi[k] = -std::numeric_limits<double>::infinity();
+    }
+    for (std::int32_t i = begin; i < end; ++i)
+      for (const std::int32_t v :
+           faces_[static_cast<std::size_t>(order[static_cast<std::size_t>(i)])].v) {
+        const Vec3& p = points_[static_cast<std::size_t>(v)];
+        for (int k = 0; k < 3; ++k) {
+          lo[k] = std::min(lo[k], p[k]);
+          hi[k] = std::max(hi[k], p[k]);
+        }
+      }
+    for (int k = 0; k < 3; ++k) {
+      node.lo[k] = down(lo[k]);
+      node.hi[k] = up(hi[k]);
+    }
+    return;
+  }
+  // Median split by centroid along the widest axis of the centroids.
+  const std::int32_t mid = begin + (end - begin) / 2;
+  std::nth_element(order.begin() + begin, order.begin() + mid, order.begin() + end,
+                   [&](std::int32_t x, std::int32_t y) {
+                     return centroids[static_cast<std::size_t>(x)][axis] <
+                            centroids[static_cast<std::size_t>(y)][axis];
+                   });
+  build(order, centroids, begin, mid);
+  const auto right = nodes_.size();
+  build(order, centroids, mid, end);
+  Node& inner = nodes_[self]; // nodes_ may have grown
+  const Node& l = nodes_[self + 1];
+  const Node& r = nodes_[right];
+  inner.first = static_cast<std::int32_t>(right);
+  inner.count = 0;
+  for (int k = 0; k < 3; ++k) {
+    inner.lo[k] = std::min(l.lo[k], r.lo[k]);
+    inner.hi[k] = std::max(l.hi[k], r.hi[k]);
+  }
+}
+
+RayHit RayCaster::first_hit(const Vec3& origin, const Vec3& direction, double t_min, double t_max,
+                            VertexHandle skip) const {
+  for (int k = 0; k < 3; ++k)
+    if (!std::isfinite(origin[k]) || !std::isfinite(direction[k]))
+      throw InvalidArgument("ray caster: the ray's origin and direction must be finite");
+  if (!(direction.sqrnorm() > 0.0))
+    throw InvalidArgument("ray caster: the ray's direction is zero");
+  if (!(t_min <= t_max))
+    throw InvalidArgument(
+        fmt::format("ray caster: t_min {} must not exceed t_max {}", t_min, t_max));
+  RayHit hit;
+  if (nodes_.empty()) return hit;
+  double inv[3];
+  for (int k = 0; k < 3; ++k) inv[k] = 1.0 / direction[k]; // +-inf on an axis-parallel ray
+  const int skipped = skip.is_valid() ? skip.idx() : -1;
+  double best = t_max;
+  constexpr double kTolerance = 1e-12;
+
+  // Does the ray meet the node's box within (t_min, best]?
+  auto meets = [&](const Node& n) {
+    double enter = t_min, leave = best;
+    for (int k = 0; k < 3; ++k) {
+      if (direction[k] == 0.0) {
+        if (origin[k] < n.lo[k] || origin[k] > n.hi[k]) return false;
+        continue;
+      }
+      double t0 = (n.lo[k] - origin[k]) * inv[k], t1 = (n.hi[k] - origin[k]) * inv[k];
+      if (t0 > t1) std::swap(t0, t1);
+      enter = std::max(enter, t0);
+      leave = std::min(leave, t1);
+      if (enter > leave) return false;
+    }
+    return true;
+  };
+
+  std::int32_t stack[kMaxDepth];
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0) {
+    const Node& n = nodes_[static_cast<std::size_t>(stack[--top])];
+    if (!meets(n)) continue;
+    if (n.count == 0) {
+      // Visit the child nearer along the ray first (pushed last).
+      const auto left = static_cast<std::int32_t>(&n - nodes_.data()) + 1, right = n.first;
+      const Node& l = nodes_[static_cast<std::size_t>(left)];
+      const Node& r = nodes_[static_cast<std::size_t>(right)];
+      int axis = 0;
+      for (int k = 1; k < 3; ++k)
+        if (std::abs(direction[k]) > std::abs(direction[axis])) axis = k;
+      const bool left_first =
+          (direction[axis] >= 0) == (l.lo[axis] + l.hi[axis] <= r.lo[axis] + r.hi[axis]);
+      assert(top + 2 <= kMaxDepth); // each level holds at most one pending sibling
+      stack[top++] = left_first ? right : left;
+      stack[top++] = left_first ? left : right;
+      continue;
+    }
+    for (std::int32_t i = n.first; i < n.first + n.count; ++i) {
+      const Face& f = faces_[static_cast<std::size_t>(i)];
+      if (f.v[0] == skipped || f.v[1] == skipped || f.v[2] == skipped) continue;
+      // Möller–Trumbore.
+      const Vec3& a = points_[static_cast<std::size_t>(f.v[0])];
+      const Vec3 ab = points_[static_cast<std::size_t>(f.v[1])] - a;
+      const Vec3 ac = points_[static_cast<std::size_t>(f.v[2])] - a;
+      const Vec3 p = OpenMesh::cross(direction, ac);
+      const double det = OpenMesh::dot(ab, p);
+      if (det == 0.0) continue;
+      const double inv_det = 1.0 / det;
+      const Vec3 s = origin - a;
+      const double u = OpenMesh::dot(s, p) * inv_det;
+      if (u < -kTolerance || u > 1.0 + kTolerance) continue;
+      const Vec3 q = OpenMesh::cross(s, ab);
+      const double v = OpenMesh::dot(direction, q) * inv_det;
+      if (v < -kTolerance || u + v > 1.0 + kTolerance) continue;
+      const double t = OpenMesh::dot(ac, q) * inv_det;
+      if (!(t > t_min) || !(t <= best)) continue;
+      best = t;
+      hit.t = t;
+      hit.face = FaceHandle(f.face);
+      hit.bary = {1.0 - u - v, u, v};
+    }
+  }
+  return hit;
+}
+
+} // namespace remora
