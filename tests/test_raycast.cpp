@@ -95,6 +95,21 @@ TEST(RayCaster, AgreesWithASearchOverEveryFace) {
   EXPECT_GT(met, 1000);
 }
 
+// Above 65,536 faces the tree's two halves are built on two threads and spliced.
+TEST(RayCaster, ALargeMeshsTreeAgreesToo) {
+  Mesh ball = make_icosphere(6, 1.0); // 81,920 faces
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> noise(-0.02, 0.02), u(-1, 1);
+  for (const VertexHandle v : ball.vertices()) ball.set_point(v, ball.point(v) * (1 + noise(rng)));
+  const RayCaster caster(ball);
+  for (int i = 0; i < 300; ++i) {
+    const Vec3 o(0.5 * u(rng), 0.5 * u(rng), 0.5 * u(rng)), d(u(rng), u(rng), u(rng));
+    const RayHit hit = caster.first_hit(o, d, 0.0, kInf);
+    ASSERT_TRUE(hit.face.is_valid()) << "ray " << i; // every ray from inside leaves the ball
+    EXPECT_NEAR(hit.t, brute_force(ball, o, d, 0.0, kInf), 1e-9) << "ray " << i;
+  }
+}
+
 TEST(RayCaster, FromAVertexSkipsItsOwnFacesAndMeetsTheFarSide) {
   const Mesh cube = make_cube(3, 2.0);
   const RayCaster caster(cube);

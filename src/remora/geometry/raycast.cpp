@@ -14,7 +14,8 @@ namespace remora {
 namespace {
 
 constexpr std::int32_t kLeafSize = 4;
-constexpr int kMaxDepth = 64; // median splits: depth <= log2(faces) + 1
+constexpr int kMaxDepth = 64;                 // median splits: depth <= log2(faces) + 1
+constexpr std::int32_t kSplitFaces = 1 << 16; // below, one thread builds the tree
 
 float down(double x) {
   const auto f = static_cast<float>(x);
@@ -54,20 +55,21 @@ RayCaster::RayCaster(const Mesh& mesh) {
   std::vector<std::int32_t> order(faces_.size());
   for (std::size_t i = 0; i < order.size(); ++i) order[i] = static_cast<std::int32_t>(i);
   nodes_.reserve(2 * faces_.size() / kLeafSize + 1);
-  build(order, centroids, 0, static_cast<std::int32_t>(order.size()));
+  build(nodes_, order, centroids, 0, static_cast<std::int32_t>(order.size()), true);
   std::vector<Face> sorted;
   sorted.reserve(faces_.size());
   for (const std::int32_t i : order) sorted.push_back(faces_[static_cast<std::size_t>(i)]);
   faces_ = std::move(sorted);
 }
 
-// Builds the subtree over order[begin, end) (indices into faces_ and centroids) below a new
-// node: leaves take their bounds from their faces, inner nodes the union of their children's, so
-// every face is read once.
-void RayCaster::build(std::vector<std::int32_t>& order, const std::vector<Vec3>& centroids,
-                      std::int32_t begin, std::int32_t end) {
-  const auto self = nodes_.size();
-  nodes_.push_back({});
+// Appends to `nodes` the subtree over order[begin, end) (indices into faces_ and centroids):
+// leaves take their bounds from their faces, inner nodes the union of their children's, so every
+// face is read once. With `split`, a large range builds its two halves on two threads.
+void RayCaster::build(std::vector<Node>& nodes, std::vector<std::int32_t>& order,
+                      const std::vector<Vec3>& centroids, std::int32_t begin, std::int32_t end,
+                      bool split) const {
+  const auto self = nodes.size();
+  nodes.push_back({});
   double lo[3], hi[3];
   for (int k = 0; k < 3; ++k) {
     lo[k] = std::numeric_limits<double>::infinity();
@@ -84,7 +86,7 @@ void RayCaster::build(std::vector<std::int32_t>& order, const std::vector<Vec3>&
   for (int k = 1; k < 3; ++k)
     if (hi[k] - lo[k] > hi[axis] - lo[axis]) axis = k;
   if (end - begin <= kLeafSize || !(hi[axis] > lo[axis])) {
-    Node& node = nodes_[self];
+    Node& node = nodes[self];
     node.first = begin;
     node.count = end - begin;
     for (int k = 0; k < 3; ++k) {
@@ -113,12 +115,29 @@ void RayCaster::build(std::vector<std::int32_t>& order, const std::vector<Vec3>&
                      return centroids[static_cast<std::size_t>(x)][axis] <
                             centroids[static_cast<std::size_t>(y)][axis];
                    });
-  build(order, centroids, begin, mid);
-  const auto right = nodes_.size();
-  build(order, centroids, mid, end);
-  Node& inner = nodes_[self]; // nodes_ may have grown
-  const Node& l = nodes_[self + 1];
-  const Node& r = nodes_[right];
+  std::size_t right = 0;
+  if (split && end - begin > kSplitFaces) {
+    // The halves' subtrees in two arrays (their right-child indices local), then spliced.
+    std::vector<Node> halves[2];
+#pragma omp parallel for num_threads(2)
+    for (int h = 0; h < 2; ++h)
+      build(halves[h], order, centroids, h == 0 ? begin : mid, h == 0 ? mid : end, false);
+    right = self + 1 + halves[0].size();
+    for (int h = 0; h < 2; ++h) {
+      const auto offset = static_cast<std::int32_t>(h == 0 ? self + 1 : right);
+      for (Node n : halves[h]) {
+        if (n.count == 0) n.first += offset;
+        nodes.push_back(n);
+      }
+    }
+  } else {
+    build(nodes, order, centroids, begin, mid, false);
+    right = nodes.size();
+    build(nodes, order, centroids, mid, end, false);
+  }
+  Node& inner = nodes[self]; // nodes may have grown
+  const Node& l = nodes[self + 1];
+  const Node& r = nodes[right];
   inner.first = static_cast<std::int32_t>(right);
   inner.count = 0;
   for (int k = 0; k < 3; ++k) {

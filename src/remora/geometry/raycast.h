@@ -49,8 +49,9 @@ private:
     std::int32_t v[3]; // corners, by vertex idx() into points_
     std::int32_t face;
   };
-  void build(std::vector<std::int32_t>& order, const std::vector<Vec3>& centroids,
-             std::int32_t begin, std::int32_t end);
+  void build(std::vector<Node>& nodes, std::vector<std::int32_t>& order,
+             const std::vector<Vec3>& centroids, std::int32_t begin, std::int32_t end,
+             bool split) const;
   std::vector<Vec3> points_; // the mesh's vertices
   std::vector<Node> nodes_;
   std::vector<Face> faces_; // in the order of the leaves
