@@ -915,6 +915,21 @@ void expect_papers_area_figures(const RemeshResult& r, SymmetryRows rows) {
   EXPECT_LT(rep.tracked_excess_max, 0.5);
 }
 
+// Every goal of docs/remesh.md's table: the paper's area figures with the defect over all rows,
+// the smallest and the mean angle, 99 % of the edges in the band.
+void expect_every_goal(const RemeshResult& r) {
+  const RemeshReport& rep = r.report;
+  EXPECT_LT(rep.after_equalization.mixed_area.rel_mad, 0.05);
+  EXPECT_GT(
+      std::pow(rep.after_cycles.mixed_area.rel_std / rep.after_equalization.mixed_area.rel_std,
+               2.0),
+      5.0);
+  EXPECT_LT(rep.symmetry_defect_output, 0.06);
+  EXPECT_GE(rep.after_equalization.angles.min_deg, 25.0);
+  EXPECT_LT(rep.after_equalization.angles.mean_abs_deviation_from_60_deg, 7.0);
+  EXPECT_GE(fraction_in_band(r.mesh, rep.target_length), 0.99);
+}
+
 // The paper's claims on real closed meshes of ../shared/data (skipped when absent).
 class RemeshData : public ::testing::TestWithParam<const char*> {};
 
@@ -1100,20 +1115,12 @@ TEST(RemeshFeaturetype, MeetsEveryGoalWithTheExtraCyclesAndTheOdtTarget) {
   const RemeshResult r = remesh(input);
   expect_sound_output(r, input);
   const RemeshReport& rep = r.report;
-  // The paper's area figures (expect_papers_area_figures but its bound on the tracked
-  // locations, which are 3e-3 l farther than the closest points here, as on the other CAD parts).
-  EXPECT_LT(rep.after_equalization.mixed_area.rel_mad, 0.05);
-  EXPECT_GT(
-      std::pow(rep.after_cycles.mixed_area.rel_std / rep.after_equalization.mixed_area.rel_std,
-               2.0),
-      5.0);
-  EXPECT_LT(rep.symmetry_defect_output, 0.06);
+  expect_every_goal(r);
+  // The tracked locations are 3e-3 l farther than the closest points here, as on the other CAD
+  // parts.
   EXPECT_LT(rep.tracked_excess_mean, 0.01);
   EXPECT_GT(rep.cycles, RemeshOptions{}.cycles);
-  EXPECT_GE(rep.after_equalization.angles.min_deg, 25.0);
-  EXPECT_LT(rep.after_equalization.angles.mean_abs_deviation_from_60_deg, 7.0);
   const double in_band = fraction_in_band(r.mesh, rep.target_length);
-  EXPECT_GE(in_band, 0.99);
 
   RemeshOptions seven;
   seven.max_cycles = seven.cycles;
@@ -1146,16 +1153,7 @@ TEST(RemeshFeaturetype, TheSmoothedPartMeetsEveryGoalWithTheFeatureCap) {
   const Mesh base = smoothed(LowPassOptions{}.feature_cap);
   const RemeshResult r = remesh(base);
   expect_sound_output(r, base);
-  const RemeshReport& rep = r.report;
-  EXPECT_LT(rep.after_equalization.mixed_area.rel_mad, 0.05);
-  EXPECT_GT(
-      std::pow(rep.after_cycles.mixed_area.rel_std / rep.after_equalization.mixed_area.rel_std,
-               2.0),
-      5.0);
-  EXPECT_LT(rep.symmetry_defect_output, 0.06);
-  EXPECT_GE(rep.after_equalization.angles.min_deg, 25.0);
-  EXPECT_LT(rep.after_equalization.angles.mean_abs_deviation_from_60_deg, 7.0);
-  EXPECT_GE(fraction_in_band(r.mesh, rep.target_length), 0.99);
+  expect_every_goal(r);
 
   RemeshOptions quick;
   quick.compute_report = false;
