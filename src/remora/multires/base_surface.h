@@ -24,8 +24,9 @@
 // So σ varies per vertex: σ_i = min(σ, feature_cap × the vertex's half-width), the half-width
 // measured by rays across the part (geometry/thickness.h), then relaxed to the largest field
 // below that which changes by at most cap_slope per unit length along edges; an edge's weight
-// is scaled by σ_i σ_j instead of σ². A part thicker than 2σ/feature_cap everywhere is filtered
-// exactly as without the cap. docs/editing.md has what it measured.
+// is scaled by σ_i σ_j instead of σ². A boundary loop's σ is at most feature_cap × its radius
+// (perimeter / 2π). A part thicker than 2σ/feature_cap everywhere, with loops longer than
+// 2πσ/feature_cap, is filtered exactly as without the cap. docs/editing.md has what it measured.
 #pragma once
 
 #include <cstddef>
