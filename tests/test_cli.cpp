@@ -221,6 +221,10 @@ TEST_F(Cli, RemeshLowPassCapsThinParts) {
   ASSERT_EQ(plain.exit_code, 0) << plain.err;
   EXPECT_EQ(nlohmann::json::parse(plain.out)["low_pass"]["sigma_capped_vertices"], 0);
   EXPECT_EQ(run(base + "--low-pass-cap -1").exit_code, 2);
+  // The cap without --low-pass would change nothing: a usage error, not a silent no-op.
+  const CliRun alone = run("remesh " + in.string() + " -o " + out.string() + " --low-pass-cap 0.5");
+  EXPECT_EQ(alone.exit_code, 2);
+  EXPECT_NE(alone.err.find("--low-pass"), std::string::npos) << alone.err;
 }
 
 TEST_F(Cli, RemeshRejectsBadOptionsBeforeWorking) {

@@ -176,15 +176,18 @@ void add_remesh_command(CLI::App& app) {
                 "Keep vertex updates in the tangent plane instead of projecting onto the input");
   cmd->add_flag("--report", a->report, "Print quality figures, operation counts and timings");
   cmd->add_flag("--json", a->json, "Print the report as one JSON object");
-  cmd->add_option("--low-pass", a->low_pass,
-                  "Remesh the low-pass filtered surface instead, as `remora edit` builds its base "
-                  "(sigma in mean edge lengths; the editor's default is 2)")
-      ->check(CLI::NonNegativeNumber);
+  auto* low_pass_flag =
+      cmd->add_option(
+             "--low-pass", a->low_pass,
+             "Remesh the low-pass filtered surface instead, as `remora edit` builds its base "
+             "(sigma in mean edge lengths; the editor's default is 2)")
+          ->check(CLI::NonNegativeNumber);
   cmd->add_option("--low-pass-cap", a->filter.feature_cap,
                   "With --low-pass: sigma at most this many times the part's local half-width, so "
                   "thin tubes and small holes are not pinched (0 = one sigma everywhere)")
       ->check(CLI::NonNegativeNumber)
-      ->capture_default_str();
+      ->capture_default_str()
+      ->needs(low_pass_flag);
   cmd->callback([a] {
     format_from_path(a->out); // fail on an unknown extension before the long work
     LoadResult loaded = read_mesh(a->in);
