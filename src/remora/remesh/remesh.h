@@ -7,7 +7,8 @@
 // never modified. Boundaries stay on the input boundary; boundary corners sharper than
 // `corner_angle_deg` stay where they are; with `feature_angle_deg`, so do the input's feature
 // lines and their corners (docs/remesh.md, "Feature lines"). Deterministic: the same input and
-// options give the same output, whatever the number of threads.
+// options give the same output, whatever the number of threads. The steps live in files named
+// after them (remesher.h lists them).
 #pragma once
 
 #include <functional>
@@ -43,24 +44,20 @@ struct RemeshOptions {
   /// inflate the mean (length_scale() in geometry/measures.h).
   double target_length = 0.0;
   double length_factor = 0.9;
-  /// Cycles of split (> 4/3 l), collapse (< 4/5 l), valence flips, tangential smoothing: at
+  /// Cycles of split (> 4/3 l), collapse (< 4/5 l), valence flips, tangential smoothing (§4): at
   /// least `cycles`, then more, up to `max_cycles`, while the last one still split, collapsed or
-  /// flipped more than `settle_fraction` × the faces. The paper says about 5; the cycles are
-  /// still converging there: 7 took the mean |θ−60°| down by 0.2–0.9° on every mesh of
-  /// docs/remesh.md's table (bunny 7.54° → 6.97°, conrod 7.84° → 6.93°). Organic and open
-  /// meshes settle by then (their seventh cycle touches 0.75–2.8 % of the faces); CAD parts keep
-  /// reconnecting around their creases (5 %) and gain from 2–4 more (featuretype 7.23° → 6.91°).
+  /// flipped more than `settle_fraction` × the faces. The paper says about 5; at 7 organic and
+  /// open meshes have settled, while CAD parts keep reconnecting around their creases and gain
+  /// from a few more (docs/remesh.md, "Design notes").
   int cycles = 7;
   /// The most cycles; values below `cycles` mean `cycles` (no extra cycles).
   int max_cycles = 12;
   /// An extra cycle runs while the last cycle's splits, collapses and valence flips together
   /// exceed this fraction of the faces. In [0, 1]; 1 never adds a cycle (a first cycle on
-  /// needles may change more than all the faces: conrod.stl 313 %).
+  /// needles may change more than all the faces).
   double settle_fraction = 0.03;
-  /// Iterations of the area-equalizing fine-tuning (§4); 0 skips it. With the momentum below the
-  /// figures swing for a few iterations before they settle: 9 is the first count from which on
-  /// (9, 10, 12, 16 measured) AcrossRiver meets the full symmetry defect and gears the mean angle
-  /// at once (6, without the momentum, until session 12; docs/remesh.md, "Momentum").
+  /// Iterations of the area-equalizing fine-tuning (§4); 0 skips it. With the momentum below,
+  /// the figures swing for a few iterations before they settle (docs/remesh.md, "Momentum").
   int equalize_iterations = 9;
   Equalization equalization = Equalization::Newton;
   /// Damping factor λ of the area-equalizing update (both methods).
@@ -68,18 +65,14 @@ struct RemeshOptions {
   /// Newton only: weight μ of the tangential-smoothing term, relative to the area term.
   double equalize_smoothing = 2.5;
   /// Newton only: where the smoothing term pulls. The ODT point keeps more edges in the band
-  /// [4/5 l, 4/3 l] than the centroid (featuretype 98.8 → 99.4 % at the same 11 cycles, blade
-  /// 98.6 → 99.1 % at 7) and equalizes areas further (variance reduction 6.9–10.4× → 7.1–12.0×
-  /// on docs/remesh.md's table, with the extra cycles) for about 0.1° of mean |θ−60°|; its pull
-  /// is weaker, hence μ = 2.5 against the centroid's 1.5 (docs/remesh.md, session 13).
+  /// [4/5 l, 4/3 l] than the centroid and equalizes areas further, for about 0.1° of mean
+  /// |θ−60°|; its pull is weaker, hence the default μ = 2.5 (1.5 suits the centroid;
+  /// docs/remesh.md, "Design notes").
   SmoothingTarget smoothing_target = SmoothingTarget::Odt;
   /// Newton only: heavy-ball momentum β (Polyak). Each fine-tuning move adds β × the vertex's
   /// previous move (taken into its tangent plane): the damped per-vertex (Jacobi) steps are slow
   /// on area errors that span many rings (the deficit of the boundary cells), and the momentum
-  /// carries them further. At 0.5 and 9 iterations, against 0 and 6, the variance reduction
-  /// grows from 5.9–8.5× to 6.9–10.4×, AcrossRiver's full symmetry defect falls from 0.063 to
-  /// 0.059 (the goal) and the mean |θ−60°| falls on most meshes too (gears 7.02° → 6.97°;
-  /// docs/remesh.md). 0 turns it off; must be < 1.
+  /// carries them further (docs/remesh.md, "Momentum"). 0 turns it off; must be < 1.
   double equalize_momentum = 0.5;
   /// After every fine-tuning iteration, flip the edges whose opposite angles sum to more than π
   /// (intrinsic Delaunay flips): the fine-tuning then costs less triangle shape (docs/remesh.md).
@@ -92,10 +85,10 @@ struct RemeshOptions {
   /// Newton only: the boundary vertices' areas join the residuals, with the same target Ā, and
   /// the vertices next to the boundary take Newton steps, placed so that no edge of their ring
   /// leaves the band [4/5 l, 4/3 l] (or goes further out of it). A boundary vertex's Voronoi
-  /// cell ends at the boundary, so inside the band it cannot reach Ā, but its area goes from
-  /// about 0.47 Ā to 0.55–0.6 Ā: the open meshes' full symmetry defect drops by 12–32 %
-  /// (AcrossRiver 0.142 → 0.096, camelhead 0.078 → 0.064; docs/remesh.md). false: those
-  /// vertices only take tangential smoothing, as before session 8.
+  /// cell ends at the boundary, so inside the band it cannot reach Ā, but its area grows from
+  /// about half of Ā to 0.55–0.6 Ā, which lowers an open mesh's full symmetry defect
+  /// (docs/remesh.md). false: the vertices next to the boundary only take tangential
+  /// smoothing.
   bool equalize_boundary = true;
   /// Project moved vertices back onto the input surface (true), or only keep updates in the
   /// tangent plane (the paper's cheaper variant).
@@ -120,7 +113,7 @@ struct RemeshOptions {
   /// boundary as the cycles make it.
   double boundary_spacing = 1.2;
   /// Fill the quality part of RemeshReport (figures, symmetry defects, distances to the input).
-  /// Off, only counts and timings are reported: 10-16 % faster, for callers that need no figures.
+  /// Off, only counts and timings are reported (faster), for callers that need no figures.
   bool compute_report = true;
   /// Worker threads for the data-parallel passes; 0 = all hardware threads.
   int threads = 0;
@@ -159,7 +152,7 @@ struct RemeshReport {
   std::size_t guarded_moves = 0;  ///< fine-tuning moves halved or dropped (equalize_guard_deg)
   std::size_t repairs = 0;        ///< flips and collapses of triangles below repair_angle_deg
   /// Wall time per phase in milliseconds ("split", "collapse", "flip", "smooth", "repair",
-  /// "equalize", "correspondence", "report", "total").
+  /// "equalize", "reorder", "correspondence", "total"; "report" when compute_report).
   std::map<std::string, double> milliseconds;
 };
 
