@@ -99,10 +99,10 @@ const PICTURES = [
     panels: [
       { label: 'featuretype.STL: its own triangles (74 % needles)',
         show: { 'show-edges': 1 },
-        camera: [2.0, -3.7, 3.5, 0, -0.1, 0.4, 0, 0, 1] },
+        camera: [2.2, -4.1, 3.6, 0, -0.15, 0.3, 0, 0, 1] },
       { label: 'its remeshed base, coloured by vertex area',
         show: { 'show-mesh': 0, 'show-base': 1, 'show-wire': 1 },
-        camera: [2.0, -3.7, 3.5, 0, -0.1, 0.4, 0, 0, 1] },
+        camera: [2.2, -4.1, 3.6, 0, -0.15, 0.3, 0, 0, 1] },
     ],
   },
   {
