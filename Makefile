@@ -45,6 +45,16 @@ demo: build
 serve: build
 	$(BUILD)/bin/remora serve $(DEMO_MESH) --port $(PORT)
 
+# The pictures in docs/images/ (bunny_ear, acrossriver_lift, base_area, needles_base), rendered
+# from real results: `remora serve` edits, the page draws in headless chromium
+# (scripts/render_pictures.mjs; chromium is installed when missing). The shared meshes come from
+# ../shared/data (or REMORA_DATA); a missing one skips its picture. Not part of `make test`, whose
+# WebEditor.Pictures runs the same script at a low resolution into the build folder.
+.PHONY: pictures
+pictures: build
+	@scripts/bootstrap.sh --web
+	node scripts/render_pictures.mjs --out docs/images --cli $(BUILD)/bin/remora --web-root $(BUILD)/web
+
 # Release build with warnings as errors, the formatting check, then the unit tests again under
 # AddressSanitizer + UndefinedBehaviorSanitizer.
 test: deps-web format-check test-release test-asan

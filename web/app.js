@@ -9,6 +9,22 @@ const FIXED = -2, FREE = -1;
 const HANDLE_COLORS = [[0.90, 0.30, 0.25], [0.25, 0.55, 0.95], [0.30, 0.80, 0.40], [0.85, 0.45, 0.90],
                        [0.95, 0.60, 0.20], [0.20, 0.80, 0.80]];
 const $ = (id) => document.getElementById(id);
+// Display options in the URL (rendering only; scripts/render_pictures.mjs uses them):
+//   ui=0                          no panel, messages, progress or manipulator over the view;
+//   camera=px,py,pz,tx,ty,tz[,ux,uy,uz]  the camera's position, target and up, instead of the fit;
+//   show-base, show-wire, show-mesh, show-edges = 1|0   the "Show" checkboxes' initial state;
+//   area-range=R                  the base's area colours saturate at ±R (default 0.2: ±20 %).
+const params = new URLSearchParams(window.location.search);
+const showUi = params.get('ui') !== '0';
+if (!showUi) document.body.classList.add('no-ui');
+for (const id of ['show-base', 'show-wire', 'show-mesh', 'show-edges'])
+  if (params.has(id)) $(id).checked = params.get(id) === '1';
+const areaRange = Number(params.get('area-range')) > 0 ? Number(params.get('area-range')) : 0.2;
+let cameraParam = params.has('camera') ? params.get('camera').split(',').map(Number) : null;
+if (cameraParam && !((cameraParam.length === 6 || cameraParam.length === 9) && cameraParam.every(Number.isFinite))) {
+  console.error('camera= needs 6 or 9 numbers: px,py,pz,tx,ty,tz[,ux,uy,uz]; ignored');
+  cameraParam = null;
+}
 
 // ---- view ---------------------------------------------------------------------------------------
 const view = $('view');
@@ -19,6 +35,8 @@ const scene = new THREE.Scene();
 scene.background = new THREE.Color(0x20242a);
 const camera = new THREE.PerspectiveCamera(40, 1, 0.001, 1000);
 scene.add(camera);
+// Before the orbit controls, which orbit about the up they find.
+if (cameraParam?.length === 9) camera.up.fromArray(cameraParam, 6).normalize();
 // A headlight and a grazing key light: surface detail shows as shading.
 scene.add(new THREE.HemisphereLight(0xffffff, 0x404048, 0.9));
 const key = new THREE.DirectionalLight(0xffffff, 1.6);
@@ -32,9 +50,12 @@ scene.add(pivot);
 const gizmoHelper = gizmo.getHelper ? gizmo.getHelper() : gizmo;
 scene.add(gizmoHelper);
 
+// The surface sits a little behind its own wireframe (show-edges), which shares its geometry.
 const material = new THREE.MeshStandardMaterial({ vertexColors: true, roughness: 0.75, metalness: 0.0,
-                                                  side: THREE.DoubleSide });
-let mesh = null, baseLines = null;
+                                                  side: THREE.DoubleSide,
+                                                  polygonOffset: true, polygonOffsetFactor: 1, polygonOffsetUnits: 1 });
+const edgeMaterial = new THREE.MeshBasicMaterial({ color: 0x30343c, wireframe: true });
+let mesh = null, edges = null, baseLines = null;
 
 function resize() {
   const w = view.clientWidth, h = view.clientHeight;
@@ -116,10 +137,12 @@ async function fetchMesh(fit) {
   geometry.setIndex(new THREE.BufferAttribute(state.indices, 1));
   geometry.computeVertexNormals();
   geometry.computeBoundingSphere();
-  if (mesh) { scene.remove(mesh); mesh.geometry.dispose(); }
+  if (mesh) { scene.remove(mesh); scene.remove(edges); mesh.geometry.dispose(); }
   mesh = new THREE.Mesh(geometry, material);
-  mesh.visible = $('show-mesh').checked;
+  edges = new THREE.Mesh(geometry, edgeMaterial);
+  showMesh();
   scene.add(mesh);
+  scene.add(edges);
   await fetchRegion();
   if (fit) fitCamera();
   if (baseShown()) await showBase(true);
@@ -131,6 +154,10 @@ function fitCamera() {
   camera.near = sphere.radius / 100;
   camera.far = sphere.radius * 100;
   camera.position.copy(sphere.center).add(new THREE.Vector3(0, 0, sphere.radius * 2.8));
+  if (cameraParam) {
+    camera.position.fromArray(cameraParam, 0);
+    orbit.target.fromArray(cameraParam, 3);
+  }
   camera.updateProjectionMatrix();
   orbit.update();
   $('radius').max = (sphere.radius).toPrecision(3);
@@ -333,7 +360,7 @@ function handleCentre(j) {
 
 function placeGizmo() {
   const centre = state.movable && state.labels ? handleCentre(state.selected) : null;
-  if (!centre) { gizmo.detach(); return; }
+  if (!centre || !showUi) { gizmo.detach(); return; }
   pivot.position.copy(centre);
   pivot.quaternion.identity();
   pivot.scale.set(1, 1, 1);
@@ -421,8 +448,8 @@ async function showBase(refetchIndices) {
     const areas = await binary('base/areas', Float32Array);
     const colours = new Float32Array(3 * areas.length);
     for (let v = 0; v < areas.length; ++v) {
-      // Blue below the mean area, white at it, red above: ±20 % saturates.
-      const t = Math.max(-1, Math.min(1, (areas[v] - 1) / 0.2));
+      // Blue below the mean area, white at it, red above: ±20 % saturates (area-range= in the URL).
+      const t = Math.max(-1, Math.min(1, (areas[v] - 1) / areaRange));
       colours[3 * v] = t > 0 ? 1 : 1 + t; colours[3 * v + 1] = 1 - Math.abs(t); colours[3 * v + 2] = t < 0 ? 1 : 1 - t;
     }
     const geometry = new THREE.BufferGeometry();
@@ -498,7 +525,13 @@ $('undo').onclick = () => task(() => history('undo'));
 $('redo').onclick = () => task(() => history('redo'));
 $('show-base').onchange = () => task(() => showBase(false));
 $('show-wire').onchange = () => task(() => showBase(false));
-$('show-mesh').onchange = () => { if (mesh) mesh.visible = $('show-mesh').checked; };
+function showMesh() {
+  if (!mesh) return;
+  mesh.visible = $('show-mesh').checked;
+  edges.visible = $('show-edges').checked;
+}
+$('show-mesh').onchange = showMesh;
+$('show-edges').onchange = showMesh;
 window.addEventListener('keydown', (event) => {
   if (event.target.tagName === 'INPUT') return;
   const key = event.key.toLowerCase();
@@ -555,6 +588,9 @@ window.remora = {
   },
   setRadius(r) { $('radius').value = r; $('radius-value').textContent = String(r); },
   pivot: () => pivot.position.toArray(),
+  camera: () => camera.position.toArray(),
+  shown: () => ({ mesh: !!mesh?.visible, edges: !!edges?.visible, base: !!baseSurface?.visible,
+                  wire: !!baseLines?.visible, manipulator: !!gizmo.object }),
   labels: () => Array.from(state.labels ?? []),
   ready: () => !!mesh && state.tasks === 0 && !inFlight && !pending && state.status?.state === 'ready',
   setTool, setMode,

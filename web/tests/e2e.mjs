@@ -129,6 +129,28 @@ try {
   for (let i = 0; i < before.length; ++i) if (undone[i] !== before[i]) differ += 1;
   check(differ === 0, `undo restored every position exactly (${differ} coordinates differ)`);
 
+  // The mesh's own triangles as a wireframe (the "its triangles" checkbox).
+  await page.check('#show-edges');
+  check((await page.evaluate(() => window.remora.shown())).edges, 'the "its triangles" checkbox shows the wireframe');
+  await page.uncheck('#show-edges');
+  check(!(await page.evaluate(() => window.remora.shown())).edges, 'and unchecking it hides the wireframe');
+
+  // The display options in the URL (scripts/render_pictures.mjs): no panel or manipulator, the
+  // camera given, the checkboxes set.
+  const bare = await browser.newPage({ viewport: { width: 400, height: 300 } });
+  bare.on('pageerror', (e) => { console.log('page error:', e.message); failures += 1; });
+  await bare.goto(url + '?ui=0&show-mesh=0&show-edges=1&show-wire=1&camera=0.1,0.2,0.3,0,0.1,0');
+  await bare.waitForFunction(() => window.remora?.ready(), null, { timeout: 120000 });
+  const shown = await bare.evaluate(() => window.remora.shown());
+  const cameraAt = await bare.evaluate(() => window.remora.camera());
+  const canvasBox = await bare.locator('canvas').boundingBox();
+  check(await bare.isHidden('#panel') && canvasBox.x === 0 && canvasBox.width === 400,
+        'ui=0 hides the panel and the view fills the window');
+  check(!shown.mesh && shown.edges && shown.wire && !shown.base && !shown.manipulator,
+        `show-*= set the checkboxes, and ui=0 hides the manipulator (${JSON.stringify(shown)})`);
+  check(Math.hypot(...cameraAt.map((x, i) => x - [0.1, 0.2, 0.3][i])) < 1e-9, `camera= places the camera (${cameraAt})`);
+  await bare.close();
+
   // A broken upload: the server's message appears on the page.
   await page.setInputFiles('#file', { name: 'broken.ply', mimeType: 'application/octet-stream',
     buffer: Buffer.from('ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nend_header\n1\n2\n') });
