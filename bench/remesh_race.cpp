@@ -18,7 +18,6 @@
 // chords of the boundary polyline instead, which leaves the input boundary).
 #include <algorithm>
 #include <array>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <ctime>
@@ -43,6 +42,7 @@
 #include <nlohmann/json.hpp>
 
 #include "remora/common/memory.h"
+#include "remora/common/timer.h"
 #include "remora/geometry/measures.h"
 #include "remora/geometry/quality.h"
 #include "remora/mesh/io.h"
@@ -52,7 +52,8 @@ namespace {
 
 using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
 using SurfaceMesh = CGAL::Surface_mesh<Kernel::Point_3>;
-using Clock = std::chrono::steady_clock;
+using remora::Clock;
+using remora::ms_since;
 
 constexpr double kLengthFactor = 0.9;
 
@@ -83,10 +84,9 @@ Timing timed(F&& f) {
   const std::clock_t c0 = std::clock();
   const auto t0 = Clock::now();
   f();
-  const auto t1 = Clock::now();
+  const double wall_ms = ms_since(t0);
   const std::clock_t c1 = std::clock();
-  return {std::chrono::duration<double, std::milli>(t1 - t0).count(),
-          1000.0 * static_cast<double>(c1 - c0) / static_cast<double>(CLOCKS_PER_SEC)};
+  return {wall_ms, 1000.0 * static_cast<double>(c1 - c0) / static_cast<double>(CLOCKS_PER_SEC)};
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -250,7 +250,7 @@ std::string mesh_name(const std::string& path) {
 void race(MeshRace& r, const Args& args) {
   const auto t0 = Clock::now();
   const remora::LoadResult loaded = remora::read_mesh(r.path);
-  r.load_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+  r.load_ms = ms_since(t0);
   const remora::Mesh& input = loaded.mesh;
   r.input_faces = input.n_faces();
   r.input_vertices = input.n_vertices();

@@ -9,7 +9,6 @@
 // largest difference to the reference (the first solver), relative to the handle displacement.
 // "basis" is the editor's path: the 7 basis functions solved once, a product per move.
 #include <algorithm>
-#include <chrono>
 #include <functional>
 #include <iostream>
 #include <map>
@@ -19,6 +18,7 @@
 
 #include "commands.h"
 #include "remora/common/error.h"
+#include "remora/common/timer.h"
 #include "remora/geometry/selection.h"
 #include "remora/linalg/kharmonic.h"
 #include "remora/linalg/solver.h"
@@ -29,11 +29,6 @@
 namespace remora::cli {
 
 namespace {
-
-using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
 
 struct Row {
   std::string solver, system;
@@ -100,7 +95,7 @@ void add_bench_command(CLI::App& app) {
   cmd->callback([a] {
     const auto t_load = Clock::now();
     Mesh mesh = read_mesh(a->mesh).mesh;
-    const double load_s = seconds_since(t_load);
+    const double load_s = ms_since(t_load) / 1e3;
     double remesh_s = 0;
     if (!a->no_remesh) {
       const auto t0 = Clock::now();
@@ -108,7 +103,7 @@ void add_bench_command(CLI::App& app) {
       options.compute_report = false;
       options.length_factor = a->length_factor;
       mesh = remesh(mesh, options).mesh;
-      remesh_s = seconds_since(t0);
+      remesh_s = ms_since(t0) / 1e3;
     }
     // Seed: the vertex nearest the centroid.
     const VertexHandle seed = central_vertex(mesh);
@@ -138,7 +133,7 @@ void add_bench_command(CLI::App& app) {
     if (std::find(names.begin(), names.end(), "multigrid") != names.end()) {
       const auto t0 = Clock::now();
       multigrid = std::make_unique<MultigridSolver>(mesh, MultigridOptions{.k = a->k});
-      hierarchy_s = seconds_since(t0);
+      hierarchy_s = ms_since(t0) / 1e3;
     }
     out["multigrid_hierarchy_s"] = hierarchy_s;
     for (int size : a->sizes) {
@@ -175,7 +170,7 @@ void add_bench_command(CLI::App& app) {
           systems[system_name] = assemble_kharmonic(
               mesh, region,
               {.k = a->k, .areas = unsymmetric ? AreaWeights::Mixed : AreaWeights::Mean});
-          if (system_name == "mean") assemble_s = seconds_since(t0);
+          if (system_name == "mean") assemble_s = ms_since(t0) / 1e3;
         }
         const KHarmonicSystem& system = systems[system_name];
         const Eigen::MatrixXd rest = system.gather_constrained(positions);
@@ -214,11 +209,11 @@ void add_bench_command(CLI::App& app) {
           std::vector<double> seconds;
           Eigen::MatrixXd first;
           const auto start = Clock::now();
-          for (int m = 0; m < kMoves && (m == 0 || seconds_since(start) < 1.0); ++m) {
+          for (int m = 0; m < kMoves && (m == 0 || ms_since(start) < 1000.0); ++m) {
             const Eigen::MatrixXd in = input(m);
             const auto t0 = Clock::now();
             Eigen::MatrixXd x = solve(in);
-            seconds.push_back(seconds_since(t0));
+            seconds.push_back(ms_since(t0) / 1e3);
             if (m == 0) first = std::move(x);
           }
           row.first_solve_s = seconds.front();
@@ -232,7 +227,7 @@ void add_bench_command(CLI::App& app) {
           if (full == "multigrid") {
             const auto t0 = Clock::now();
             multigrid->set_region(region);
-            row.precompute_s = seconds_since(t0);
+            row.precompute_s = ms_since(t0) / 1e3;
             auto moved = [&](int m) { // all positions, the handle's moved
               Eigen::MatrixXd p = positions;
               for (std::size_t v = 0; v < region.label.size(); ++v)
@@ -264,7 +259,7 @@ void add_bench_command(CLI::App& app) {
               values(c, 6) = 1.0;
             }
             const Eigen::MatrixXd basis = solver->solve(system.rhs(values));
-            row.precompute_s = seconds_since(t0);
+            row.precompute_s = ms_since(t0) / 1e3;
             auto coefficients = [&](int m) {
               Eigen::MatrixXd c = Eigen::MatrixXd::Zero(7, 3);
               c.topRows(3).setIdentity();       // the rest
@@ -279,13 +274,13 @@ void add_bench_command(CLI::App& app) {
             auto solver = make_solver(options);
             const auto t0 = Clock::now();
             solver->compute(system.matrix);
-            row.precompute_s = seconds_since(t0);
+            row.precompute_s = ms_since(t0) / 1e3;
             // New values on the same pattern (another k-harmonic weighting, a region edited
             // back): only the numbers are factored again.
             if (row.precompute_s < 5.0) {
               const auto t2 = Clock::now();
               solver->factorize(system.matrix);
-              row.refactor_s = seconds_since(t2);
+              row.refactor_s = ms_since(t2) / 1e3;
             }
             x = time_moves(rhs_of_move, [&](const Eigen::MatrixXd& b) { return solver->solve(b); });
             const SolverStats stats = solver->stats();

@@ -3,7 +3,6 @@
 // geodesic support of a given number of free base vertices, and the time per frame (blend +
 // decode, no solve) over a sequence of handle moves.
 #include <algorithm>
-#include <chrono>
 #include <iostream>
 
 #include <fmt/format.h>
@@ -11,6 +10,7 @@
 
 #include "commands.h"
 #include "remora/common/error.h"
+#include "remora/common/timer.h"
 #include "remora/geometry/measures.h"
 #include "remora/geometry/selection.h"
 #include "remora/mesh/io.h"
@@ -18,15 +18,6 @@
 #include "report.h"
 
 namespace remora::cli {
-
-namespace {
-
-using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
-
-} // namespace
 
 void add_bench_edit_command(CLI::App& bench) {
   auto* cmd = bench.add_subcommand(

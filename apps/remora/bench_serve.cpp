@@ -16,6 +16,7 @@
 #include "api.h"
 #include "commands.h"
 #include "remora/common/error.h"
+#include "remora/common/timer.h"
 #include "remora/geometry/selection.h"
 #include "remora/mesh/io.h"
 #include "session.h"
@@ -103,11 +104,10 @@ void add_bench_serve_command(CLI::App& bench) {
     for (int i = 0; i < a->requests; ++i) {
       const double s = 0.02 * std::sin(0.1 * i);
       const nlohmann::json body = {{"handle", 0}, {"matrix", {1, 0, 0, s, 0, 1, 0, s, 0, 0, 1, 0}}};
-      const auto t0 = std::chrono::steady_clock::now();
+      const auto t0 = Clock::now();
       const auto r = client.Post("/api/transform", body.dump(), "application/json");
       const std::string& positions = ok(r, "transform");
-      round_trips.push_back(
-          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+      round_trips.push_back(ms_since(t0));
       frames.push_back(std::stod(r->get_header_value("X-Frame-Ms")));
       floats = positions.size() / sizeof(float);
     }

@@ -1,6 +1,5 @@
 // `remora edit`: one edit of the pipeline of paper Fig. 3 (multires/editor.h), described by an
 // EDIT.json file (multires/edit_request.h, docs/editing.md) or by quick flags.
-#include <chrono>
 #include <cmath>
 #include <fstream>
 #include <iostream>
@@ -11,6 +10,7 @@
 
 #include "commands.h"
 #include "remora/common/error.h"
+#include "remora/common/timer.h"
 #include "remora/geometry/measures.h"
 #include "remora/mesh/io.h"
 #include "remora/multires/edit_request.h"
@@ -20,11 +20,6 @@
 namespace remora::cli {
 
 namespace {
-
-using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
 
 /// "x,y,z[,w]" -> numbers; `what` names the flag in the message.
 std::vector<double> numbers(const std::string& text, std::size_t count, const std::string& what) {

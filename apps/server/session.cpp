@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <atomic>
-#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -11,6 +10,7 @@
 
 #include <fmt/format.h>
 
+#include "remora/common/timer.h"
 #include "remora/geometry/measures.h"
 #include "remora/geometry/quality.h"
 #include "remora/linalg/kharmonic.h"
@@ -19,11 +19,6 @@
 namespace remora::server {
 
 namespace {
-
-using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
 
 struct RegionKey {
   std::vector<int> support;

@@ -1,7 +1,6 @@
 #include "remora/multires/editor.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <optional>
 #include <utility>
@@ -12,17 +11,13 @@
 
 #include "remora/common/error.h"
 #include "remora/common/parallel.h"
+#include "remora/common/timer.h"
 #include "remora/geometry/laplacian.h"
 #include "remora/geometry/measures.h"
 #include "remora/multires/multigrid.h"
 
 namespace remora {
 namespace {
-
-using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
 
 int largest(const std::array<double, 3>& a) {
   return a[0] >= a[1] && a[0] >= a[2] ? 0 : (a[1] >= a[2] ? 1 : 2);
