@@ -2,8 +2,8 @@
 // request is a 4xx with a JSON error; the editing round trip (load, region, transform, commit,
 // undo, redo, export) keeps its promises.
 #include <atomic>
-#include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -225,6 +225,29 @@ TEST(Server, EditRoundTripWithUndoAndRedo) {
         (baked[3 * static_cast<std::size_t>(v) + 2] - before[3 * static_cast<std::size_t>(v) + 2]) /
         double(handle.size());
   EXPECT_NEAR(baked_rise, 0.5, 0.02);
+}
+
+// The export is the mesh I/O layer's memory writer on the current result, byte for byte, and
+// needs no file: it works without a usable temporary folder.
+TEST(Server, ExportIsTheMemoryWriterAndNeedsNoTemporaryFolder) {
+  Session s;
+  const std::string off = sphere_off();
+  ASSERT_EQ(call(s, "POST", "/api/load", off, {{"name", "sphere.off"}}).status, 202);
+  s.wait();
+  const Mesh loaded = read_mesh_from_memory(off, MeshFormat::Off, "sphere.off").mesh;
+  const char* old_tmpdir = std::getenv("TMPDIR");
+  const std::string saved = old_tmpdir ? old_tmpdir : "";
+  ::setenv("TMPDIR", "/nonexistent/remora-no-temporary-folder", 1);
+  for (const std::string format : {"obj", "ply", "stl"}) {
+    const HttpResponse r = call(s, "GET", "/api/export", "", {{"format", format}});
+    EXPECT_EQ(r.status, 200) << format << ": " << r.body;
+    const std::string name = "edited." + format;
+    EXPECT_EQ(r.body, write_mesh_to_memory(loaded, format_from_path(name), name)) << format;
+  }
+  if (old_tmpdir)
+    ::setenv("TMPDIR", saved.c_str(), 1);
+  else
+    ::unsetenv("TMPDIR");
 }
 
 TEST(Server, BusyWhileWorkingAndSafeUnderConcurrentRequests) {

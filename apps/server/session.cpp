@@ -1,12 +1,7 @@
 #include "session.h"
 
 #include <algorithm>
-#include <atomic>
-#include <cstdio>
-#include <filesystem>
-#include <fstream>
-#include <sstream>
-#include <unistd.h>
+#include <functional>
 
 #include <fmt/format.h>
 
@@ -395,16 +390,8 @@ std::string Session::export_mesh(const std::string& format) const {
     impl_->require_ready();
     result = impl_->region ? impl_->box->editor.result() : impl_->box->editor.input();
   }
-  // write_mesh() writes files atomically; a private temporary file gives the bytes.
-  const auto path = std::filesystem::temp_directory_path() /
-                    fmt::format("remora_export_{}_{}.{}", ::getpid(),
-                                std::hash<std::thread::id>{}(std::this_thread::get_id()), format);
-  write_mesh(path.string(), result);
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream bytes;
-  bytes << in.rdbuf();
-  std::filesystem::remove(path);
-  return bytes.str();
+  const std::string name = "edited." + format;
+  return write_mesh_to_memory(result, format_from_path(name), name);
 }
 
 } // namespace remora::server
