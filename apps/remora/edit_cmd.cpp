@@ -13,6 +13,7 @@
 #include "remora/common/timer.h"
 #include "remora/geometry/measures.h"
 #include "remora/mesh/io.h"
+#include "remora/multires/detail_retention.h"
 #include "remora/multires/edit_request.h"
 #include "remora/multires/editor.h"
 #include "report.h"
@@ -288,20 +289,12 @@ void add_edit_command(CLI::App& app) {
                 << " in the support)\n";
       return;
     }
-    // Figures: the largest move, and the detail retention (spread of the result minus its
-    // low-pass over that of the input, in the support).
+    // Figures: the largest move, and the detail retention in the support.
     const Eigen::MatrixXd input = positions_matrix(mesh);
     const Eigen::MatrixXd& output = editor.positions();
-    const double diagonal = bounding_box_diagonal(mesh);
-    const double max_move = (output - input).rowwise().norm().maxCoeff() / diagonal;
-    const Eigen::MatrixXd din = input - editor.low_pass(input);
-    const Eigen::MatrixXd dout = output - editor.low_pass(output);
-    double sin = 0, sout = 0;
-    for (const int v : support_ids) {
-      sin += din.row(v).squaredNorm();
-      sout += dout.row(v).squaredNorm();
-    }
-    const double retention = sin > 0 ? std::sqrt(sout / sin) : 1.0;
+    const double max_move =
+        (output - input).rowwise().norm().maxCoeff() / bounding_box_diagonal(mesh);
+    const double retention = detail_retention(editor, support_ids);
     if (a->json) {
       nlohmann::json j = to_json(editor.report());
       j["milliseconds"]["load"] = load_ms;
