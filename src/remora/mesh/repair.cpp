@@ -714,7 +714,6 @@ private:
   std::vector<Vec3> out_points_;
   std::vector<std::uint32_t> out_source_;
   std::vector<char> vertex_taken_;     // output vertex used by a triangle
-  std::vector<char> vertex_split_;     // welded vertex was split
   std::vector<std::uint32_t> copy_of_; // for copies (index - points_.size()): the welded vertex
 };
 
