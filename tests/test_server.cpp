@@ -74,7 +74,16 @@ TEST(Server, EmptySessionAnswersStatusAndRefusesTheRest) {
       call(s, "POST", "/api/transform", R"({"handle": 0, "matrix": [1,0,0,0,0,1,0,0,0,0,1,0]})"),
       409, "no mesh");
   expect_error(call(s, "GET", "/api/nowhere"), 404, "no endpoint");
-  expect_error(call(s, "POST", "/api/status"), 405, "does not take POST");
+  // A wrong method is a 405 with a JSON body and the methods the path takes in Allow.
+  const HttpResponse post_status = call(s, "POST", "/api/status");
+  expect_error(post_status, 405, "/api/status does not take POST; use GET");
+  EXPECT_EQ(post_status.headers.count("Allow") ? post_status.headers.at("Allow") : "", "GET");
+  const HttpResponse put_region = call(s, "PUT", "/api/region");
+  expect_error(put_region, 405, "does not take PUT");
+  EXPECT_EQ(put_region.headers.count("Allow") ? put_region.headers.at("Allow") : "", "GET, POST");
+  const HttpResponse get_transform = call(s, "GET", "/api/transform");
+  expect_error(get_transform, 405, "does not take GET");
+  EXPECT_EQ(get_transform.headers.count("Allow") ? get_transform.headers.at("Allow") : "", "POST");
   expect_error(call(s, "POST", "/api/load", "", {{"name", "a.ply"}}), 400, "empty");
   expect_error(call(s, "POST", "/api/load", "x"), 400, "?name=");
   expect_error(call(s, "POST", "/api/load", "x", {{"name", "a.doc"}}), 400, "extension");
