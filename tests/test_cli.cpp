@@ -115,6 +115,17 @@ TEST_F(Cli, UnknownFlagOrMissingArgumentIsAUsageError) {
   EXPECT_EQ(run("").exit_code, 2);              // no subcommand
 }
 
+// Without the page's files `remora serve` stops before listening and names the make target and
+// script that exist.
+TEST_F(Cli, ServeWithoutThePageSaysHowToBuildIt) {
+  const CliRun r = run("serve --port 0 --web-root " + dir_.string());
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("index.html missing"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("`make build`"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("scripts/build_web.sh " + dir_.string()), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("make web"), std::string::npos) << r.err;
+}
+
 TEST_F(Cli, ConvertWritesEveryFormatAndReportsTheRepair) {
   const fs::path in = dir_ / "in.stl";
   write_mesh(in.string(), make_icosphere(2));
