@@ -126,6 +126,17 @@ TEST_F(Cli, ServeWithoutThePageSaysHowToBuildIt) {
   EXPECT_EQ(r.err.find("make web"), std::string::npos) << r.err;
 }
 
+// A mesh the server refuses ends `remora bench serve` with its error and exit code 1; the
+// loopback server is stopped on the way out, not left running into a crash.
+TEST_F(Cli, BenchServeStopsItsServerOnAnError) {
+  const fs::path bad = write_text("bad.off", "OFF\n3 1 0\n0 0 0\n1 0 nan\n0 1 0\n3 0 1 2\n");
+  const CliRun r = run("bench serve --requests 1 " + bad.string());
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.err.find("bad.off: line 4: vertex 1 has a non-finite z coordinate"),
+            std::string::npos)
+      << r.err;
+}
+
 TEST_F(Cli, ConvertWritesEveryFormatAndReportsTheRepair) {
   const fs::path in = dir_ / "in.stl";
   write_mesh(in.string(), make_icosphere(2));
