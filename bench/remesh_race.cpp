@@ -8,14 +8,15 @@
 //                       [--cgal-relax-boundary] [--write-dir DIR] [mesh files...]
 //
 // Without files: the CI meshes of ../shared/data/MANIFEST.md that load as manifolds (plus
-// derived/igea_sub4.ply with --large). l = 0.9 x the loaded mesh's length scale (its mean edge length unless needles inflate it), as remesh()
-// computes it; for both the number of cycles Remora's default options run on the mesh (at least 7,
-// more while the cycles still change a CAD part: the first run of ours tells it), or exactly
-// --cycles N for both. Ours runs twice per round:
-// default options (cycles + the default equalization iterations) and cycles only (equalize_iterations = 0, the like-for-like comparison). CGAL keeps
-// the mesh boundary by default: boundary edges are split at midpoints and collapsed onto boundary
-// vertices, boundary vertices are not smoothed (--cgal-relax-boundary lets them slide along
-// chords of the boundary polyline instead, which leaves the input boundary).
+// derived/igea_sub4.ply with --large). l = 0.9 x the loaded mesh's length scale (its mean edge
+// length unless needles inflate it), as remesh() computes it; for both the number of cycles
+// Remora's default options run on the mesh (at least 7, more while the cycles still change a CAD
+// part: the first run of ours tells it), or exactly --cycles N for both. Ours runs twice per
+// round: default options (cycles + the default equalization iterations) and cycles only
+// (equalize_iterations = 0, the like-for-like comparison). CGAL keeps the mesh boundary by
+// default: boundary edges are split at midpoints and collapsed onto boundary vertices, boundary
+// vertices are not smoothed (--cgal-relax-boundary lets them slide along chords of the boundary
+// polyline instead, which leaves the input boundary).
 #include <algorithm>
 #include <array>
 #include <cmath>

@@ -1,4 +1,4 @@
-// `remora bench edit`: the editing kernel's goals (issue 5, docs/benchmarks.md): preprocessing
+// `remora bench edit`: the editing kernel's timings (docs/benchmarks.md): preprocessing
 // (base surface + remesh), set_region (map, factor, 3 + 4h basis functions, Phong encoding) for a
 // geodesic support of a given number of free base vertices, and the time per frame (blend +
 // decode, no solve) over a sequence of handle moves.

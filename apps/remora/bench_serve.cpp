@@ -1,4 +1,4 @@
-// `remora bench serve`: the browser editor's latency (issue 6, docs/benchmarks.md): the time from
+// `remora bench serve`: the browser editor's latency (docs/benchmarks.md): the time from
 // sending a transform request to having the moved positions, over loopback HTTP against an
 // in-process `remora serve`, for a geodesic support of a given number of input vertices.
 #include <algorithm>

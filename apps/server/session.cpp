@@ -149,7 +149,7 @@ void Session::wait() {
 
 void Session::start_load(std::string bytes, std::string name) {
   std::lock_guard lock(impl_->mutex);
-  const MeshFormat format = format_from_path(name); // IoError for an unknown extension, now
+  const MeshFormat format = format_from_path(name); // IoError for an unknown extension at once
   impl_->run("load", [this, bytes = std::move(bytes), name, format] {
     Impl& m = *impl_;
     const auto t0 = Clock::now();
