@@ -8,17 +8,17 @@
 //                       [--cgal-relax-boundary] [--write-dir DIR] [mesh files...]
 //
 // Without files: the CI meshes of ../shared/data/MANIFEST.md that load as manifolds (plus
-// derived/igea_sub4.ply with --large). l = 0.9 x the loaded mesh's length scale (its mean edge length unless needles inflate it), as remesh()
-// computes it; for both the number of cycles Remora's default options run on the mesh (at least 7,
-// more while the cycles still change a CAD part: the first run of ours tells it), or exactly
-// --cycles N for both. Ours runs twice per round:
-// default options (cycles + the default equalization iterations) and cycles only (equalize_iterations = 0, the like-for-like comparison). CGAL keeps
-// the mesh boundary by default: boundary edges are split at midpoints and collapsed onto boundary
-// vertices, boundary vertices are not smoothed (--cgal-relax-boundary lets them slide along
-// chords of the boundary polyline instead, which leaves the input boundary).
+// derived/igea_sub4.ply with --large). l = 0.9 x the loaded mesh's length scale (its mean edge
+// length unless needles inflate it), as remesh() computes it; for both the number of cycles
+// Remora's default options run on the mesh (at least 7, more while the cycles still change a CAD
+// part: the first run of ours tells it), or exactly --cycles N for both. Ours runs twice per
+// round: default options (cycles + the default equalization iterations) and cycles only
+// (equalize_iterations = 0, the like-for-like comparison). CGAL keeps the mesh boundary by
+// default: boundary edges are split at midpoints and collapsed onto boundary vertices, boundary
+// vertices are not smoothed (--cgal-relax-boundary lets them slide along chords of the boundary
+// polyline instead, which leaves the input boundary).
 #include <algorithm>
 #include <array>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <ctime>
@@ -43,6 +43,7 @@
 #include <nlohmann/json.hpp>
 
 #include "remora/common/memory.h"
+#include "remora/common/timer.h"
 #include "remora/geometry/measures.h"
 #include "remora/geometry/quality.h"
 #include "remora/mesh/io.h"
@@ -52,7 +53,8 @@ namespace {
 
 using Kernel = CGAL::Exact_predicates_inexact_constructions_kernel;
 using SurfaceMesh = CGAL::Surface_mesh<Kernel::Point_3>;
-using Clock = std::chrono::steady_clock;
+using remora::Clock;
+using remora::ms_since;
 
 constexpr double kLengthFactor = 0.9;
 
@@ -83,10 +85,9 @@ Timing timed(F&& f) {
   const std::clock_t c0 = std::clock();
   const auto t0 = Clock::now();
   f();
-  const auto t1 = Clock::now();
+  const double wall_ms = ms_since(t0);
   const std::clock_t c1 = std::clock();
-  return {std::chrono::duration<double, std::milli>(t1 - t0).count(),
-          1000.0 * static_cast<double>(c1 - c0) / static_cast<double>(CLOCKS_PER_SEC)};
+  return {wall_ms, 1000.0 * static_cast<double>(c1 - c0) / static_cast<double>(CLOCKS_PER_SEC)};
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -250,7 +251,7 @@ std::string mesh_name(const std::string& path) {
 void race(MeshRace& r, const Args& args) {
   const auto t0 = Clock::now();
   const remora::LoadResult loaded = remora::read_mesh(r.path);
-  r.load_ms = std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+  r.load_ms = ms_since(t0);
   const remora::Mesh& input = loaded.mesh;
   r.input_faces = input.n_faces();
   r.input_vertices = input.n_vertices();

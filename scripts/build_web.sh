@@ -5,10 +5,10 @@
 #
 #   scripts/build_web.sh OUT_DIR
 #
-# The registry is reached over the network, which fails now and then (a CI run once stopped on
-# npm's EIDLETIMEOUT after a connection hung for npm's default 5 minutes): npm gives up on a
-# silent connection after 60 s and retries each request itself, and the whole `npm ci` is tried
-# up to REMORA_NPM_ATTEMPTS times (default 3) with a growing pause before the build gives up.
+# The registry is reached over the network, which fails now and then, and npm by default waits 5
+# minutes on a silent connection: here npm gives up on one after 60 s and retries each request
+# itself, and the whole `npm ci` is tried up to REMORA_NPM_ATTEMPTS times (default 3) with a
+# growing pause before the build gives up.
 set -euo pipefail
 out=${1:?usage: scripts/build_web.sh OUT_DIR}
 here=$(cd "$(dirname "$0")/.." && pwd)

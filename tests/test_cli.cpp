@@ -115,6 +115,28 @@ TEST_F(Cli, UnknownFlagOrMissingArgumentIsAUsageError) {
   EXPECT_EQ(run("").exit_code, 2);              // no subcommand
 }
 
+// Without the page's files `remora serve` stops before listening and names the make target and
+// script that exist.
+TEST_F(Cli, ServeWithoutThePageSaysHowToBuildIt) {
+  const CliRun r = run("serve --port 0 --web-root " + dir_.string());
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("index.html missing"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("`make build`"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("scripts/build_web.sh " + dir_.string()), std::string::npos) << r.err;
+  EXPECT_EQ(r.err.find("make web"), std::string::npos) << r.err;
+}
+
+// A mesh the server refuses ends `remora bench serve` with its error and exit code 1; the
+// loopback server is stopped on the way out, not left running into a crash.
+TEST_F(Cli, BenchServeStopsItsServerOnAnError) {
+  const fs::path bad = write_text("bad.off", "OFF\n3 1 0\n0 0 0\n1 0 nan\n0 1 0\n3 0 1 2\n");
+  const CliRun r = run("bench serve --requests 1 " + bad.string());
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.err.find("bad.off: line 4: vertex 1 has a non-finite z coordinate"),
+            std::string::npos)
+      << r.err;
+}
+
 TEST_F(Cli, ConvertWritesEveryFormatAndReportsTheRepair) {
   const fs::path in = dir_ / "in.stl";
   write_mesh(in.string(), make_icosphere(2));

@@ -1,6 +1,8 @@
-// common/: the data-parallel loop and the allocator settings of the apps.
+// common/: the data-parallel loop, the allocator settings of the apps and the wall clock.
 #include <atomic>
+#include <chrono>
 #include <cstddef>
+#include <thread>
 #include <vector>
 
 #if defined(__GLIBC__)
@@ -11,6 +13,7 @@
 
 #include "remora/common/memory.h"
 #include "remora/common/parallel.h"
+#include "remora/common/timer.h"
 
 namespace remora {
 namespace {
@@ -40,6 +43,22 @@ TEST(Memory, KeepFreedMemoryServesLargeBlocksFromTheHeap) {
     EXPECT_EQ(mallinfo2().hblkhd, mapped_before) << "the block was mapped, not taken from the heap";
   }
 #endif
+}
+
+TEST(Timer, MsSinceIsTheElapsedSteadyTimeInMilliseconds) {
+  const Clock::time_point t0 = Clock::now();
+  EXPECT_GE(ms_since(t0), 0.0);
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  // Bracketed by two readings of the same clock: the unit is the millisecond, not the tick.
+  const Clock::time_point before = Clock::now();
+  const double ms = ms_since(t0);
+  const Clock::time_point after = Clock::now();
+  const auto to_ms = [](Clock::duration d) {
+    return std::chrono::duration<double, std::milli>(d).count();
+  };
+  EXPECT_GE(ms, 20.0); // sleep_for waits at least that long
+  EXPECT_GE(ms, to_ms(before - t0));
+  EXPECT_LE(ms, to_ms(after - t0));
 }
 
 } // namespace

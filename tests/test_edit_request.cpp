@@ -93,8 +93,20 @@ TEST(EditRequest, ErrorsNameTheJsonPath) {
   EXPECT_NE(error_of({{"support", {{"areas", "mean"}}}, {"handles", handles}}).find("unknown key"),
             std::string::npos);
   EXPECT_NE(error_of({{"support", {1}}, {"handles", handles}, {"areas", "median"}})
-                .find("unknown value 'median'"),
+                .find("unknown value 'median' (allowed: mean, mixed, mixed-symmetric)"),
             std::string::npos);
+  EXPECT_NE(error_of({{"support", {{"sphere", {{"center", {0, 0, 0}}, {"radius", -1}}}}},
+                      {"handles", handles}})
+                .find("edit.support.sphere.radius: must be >= 0"),
+            std::string::npos);
+  EXPECT_NE(error_of({{"support", {{"geodesic", {{"vertex", 3}, {"radius", -0.5}}}}},
+                      {"handles", handles}})
+                .find("edit.support.geodesic.radius: must be >= 0"),
+            std::string::npos);
+  EXPECT_NE(
+      error_of({{"support", {{"box", {{"min", {0, 0, 0}}, {"size", 1}}}}}, {"handles", handles}})
+          .find("unknown key 'size' (allowed: min, max)"),
+      std::string::npos);
 }
 
 TEST(Selection, SpheresBoxesAndGeodesicDiscs) {

@@ -2,9 +2,11 @@
 // checked on procedural meshes and, when present, on the real meshes of ../shared/data.
 #include <cmath>
 #include <filesystem>
+#include <random>
 #include <string>
 #include <vector>
 
+#include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
 #include "remora/common/error.h"
@@ -13,6 +15,7 @@
 #include "remora/linalg/kharmonic.h"
 #include "remora/mesh/io.h"
 #include "remora/mesh/primitives.h"
+#include "remora/multires/detail_retention.h"
 #include "remora/multires/editor.h"
 
 namespace remora {
@@ -147,19 +150,74 @@ TEST(Editor, MultigridAndTheDirectSolverGiveTheSameEdit) {
   EXPECT_LT(max_row_distance(results[0], results[1]), 1e-6 * bounding_box_diagonal(mesh));
 }
 
-// Detail retention: the spread of (result − its low-pass) over that of (input − its low-pass),
-// inside the support, for a lifted handle on a bumpy plane.
-double retention(Editor& editor, const Mesh& mesh, const std::vector<int>& support) {
+// ---- detail retention (multires/detail_retention.h) -------------------------------------------
+
+/// n rows of x, y, z uniform in [-1, 1) from the standard-specified mt19937 sequence.
+Eigen::MatrixXd random_rows(Eigen::Index n, unsigned seed) {
+  std::mt19937 rng(seed);
+  Eigen::MatrixXd x(n, 3);
+  for (Eigen::Index i = 0; i < n; ++i)
+    for (int c = 0; c < 3; ++c) x(i, c) = 2.0 * (static_cast<double>(rng()) / 4294967296.0) - 1.0;
+  return x;
+}
+
+/// Every row replaced by the mean row: linear, the same for every column, keeps constants.
+Eigen::MatrixXd mean_filter(const Eigen::MatrixXd& x) {
+  return Eigen::MatrixXd::Ones(x.rows(), 1) * x.colwise().mean();
+}
+
+TEST(DetailRetention, IsOneForRigidMotionsScaleForScalingsAndZeroWithoutDetail) {
+  const Eigen::MatrixXd x = random_rows(50, 7);
+  const std::vector<int> some = {0, 3, 4, 10, 11, 12, 40, 49};
+  EXPECT_EQ(detail_retention(x, x, some, mean_filter), 1.0); // the same sums: exactly 1
+  const Eigen::RowVector3d t(0.3, -2.0, 5.0);
+  const Eigen::MatrixXd moved = x.rowwise() + t;
+  EXPECT_NEAR(detail_retention(x, moved, some, mean_filter), 1.0, 1e-12);
+  const Eigen::Matrix3d r =
+      Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
+  const Eigen::MatrixXd turned = (x * r.transpose()).rowwise() + t;
+  EXPECT_NEAR(detail_retention(x, turned, some, mean_filter), 1.0, 1e-12);
+  EXPECT_NEAR(detail_retention(x, -2.5 * x, some, mean_filter), 2.5, 1e-12);
+  EXPECT_NEAR(detail_retention(x, mean_filter(x), some, mean_filter), 0.0, 1e-12);
+  // No detail in the input (constant rows, or no vertex at all): nothing to lose.
+  const Eigen::MatrixXd flat = Eigen::MatrixXd::Ones(50, 3);
+  EXPECT_EQ(detail_retention(flat, x, some, mean_filter), 1.0);
+  EXPECT_EQ(detail_retention(x, 3.0 * x, {}, mean_filter), 1.0);
+}
+
+TEST(DetailRetention, CountsOnlyTheGivenVertices) {
+  // With the zero filter every row is all detail: the figure is the plain RMS ratio.
+  const auto zero = [](const Eigen::MatrixXd& v) {
+    return Eigen::MatrixXd::Zero(v.rows(), v.cols()).eval();
+  };
+  const Eigen::MatrixXd x = random_rows(20, 11);
+  Eigen::MatrixXd y = random_rows(20, 12); // every row outside `some` differs
+  const std::vector<int> some = {1, 5, 6, 19};
+  for (const int v : some) y.row(v) = 2.0 * x.row(v);
+  EXPECT_NEAR(detail_retention(x, y, some, zero), 2.0, 1e-14);
+}
+
+TEST(DetailRetention, RefusesMismatchedShapesAndIds) {
+  const Eigen::MatrixXd x = random_rows(10, 3);
+  EXPECT_THROW(detail_retention(x, random_rows(9, 3), {0}, mean_filter), InvalidArgument);
+  EXPECT_THROW(detail_retention(x, x, {10}, mean_filter), InvalidArgument);
+  EXPECT_THROW(detail_retention(x, x, {-1}, mean_filter), InvalidArgument);
+  const auto shrink = [](const Eigen::MatrixXd& v) { return v.topRows(v.rows() - 1).eval(); };
+  EXPECT_THROW(detail_retention(x, x, {0}, shrink), InvalidArgument);
+}
+
+// The editor's own filter keeps constants: translating the whole input keeps every detail, and
+// an identity edit reproduces the input's.
+TEST(DetailRetention, TheEditorsFilterKeepsConstants) {
+  const Mesh mesh = bumpy_sphere(3);
+  Editor editor(mesh);
+  const auto support = sphere_ids(mesh, Vec3(0, 0, 1), 0.8);
+  editor.set_region(support, {sphere_ids(mesh, Vec3(0, 0, 1), 0.2)});
   const Eigen::MatrixXd input = positions_matrix(mesh);
-  const Eigen::MatrixXd result = editor.positions();
-  const Eigen::MatrixXd din = input - editor.low_pass(input);
-  const Eigen::MatrixXd dout = result - editor.low_pass(result);
-  double a = 0, b = 0;
-  for (const int v : support) {
-    a += dout.row(v).squaredNorm();
-    b += din.row(v).squaredNorm();
-  }
-  return std::sqrt(a / b);
+  const Eigen::MatrixXd moved = input.rowwise() + Eigen::RowVector3d(0.5, -1.0, 2.0);
+  const auto filter = [&editor](const Eigen::MatrixXd& v) { return editor.low_pass(v); };
+  EXPECT_NEAR(detail_retention(input, moved, support, filter), 1.0, 1e-6);
+  EXPECT_NEAR(detail_retention(editor, support), 1.0, 1e-6);
 }
 
 TEST(Editor, DetailsSurviveALiftOnlyWithDetailEncoding) {
@@ -175,7 +233,7 @@ TEST(Editor, DetailsSurviveALiftOnlyWithDetailEncoding) {
     Editor editor(mesh, options);
     editor.set_region(support, {handle});
     editor.set_transform(0, translation({0, 0, 0.04}));
-    const double r = retention(editor, mesh, support);
+    const double r = detail_retention(editor, support);
     (mode == DetailMode::Normal         ? normal
      : mode == DetailMode::Displacement ? displacement
                                         : none) = r;

@@ -126,9 +126,8 @@ TEST(LowPass, KeepsConstantsAndDampsShortWavelengthsMore) {
 }
 
 // A plane's boundary stays where it is: the loops are filtered as curves and the interior takes
-// them as Dirichlet values. With the surface operator's natural condition, the sides moved inward
-// by about σ (AcrossRiver: 2 mean edge lengths at σ = 2). Noise along the boundary is damped as
-// in the interior.
+// them as Dirichlet values (the surface operator's natural condition would move the sides inward
+// by about σ). Noise along the boundary is damped as in the interior.
 TEST(LowPass, KeepsAPlanesBoundaryAndSmoothsAlongIt) {
   Mesh m = make_grid(40, 40, 1.0, 1.0);
   Eigen::MatrixXd p = positions_matrix(m);
@@ -206,7 +205,7 @@ TEST(LowPass, FeatureCapKeepsAThinTubeAtOneOverOnePlusCapSquared) {
 
 // A boundary loop is capped by its own radius: the small hole of an annulus (radius 0.03, σ
 // about 7 times that) all but closes without the cap and keeps 1 / (1 + cap²) of its radius
-// with it; the outer rim (radius 1) is filtered as before.
+// with it; the outer rim (radius 1) is filtered as without the cap.
 TEST(LowPass, FeatureCapKeepsASmallHoleOpen) {
   const double inner = 0.03;
   const int segments = 24, rings = 20;

@@ -13,6 +13,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <limits>
 #include <map>
 #include <numbers>
@@ -878,6 +879,43 @@ TEST(IoRoundTrip, EveryFormat) {
   EXPECT_EQ(read_soup((dir.path() / "octa_ascii.PLY").string()).info.encoding, "ascii");
   EXPECT_EQ(read_soup((dir.path() / "octa.stl").string()).info.encoding, "binary_little_endian");
   EXPECT_EQ(read_soup((dir.path() / "octa_ascii.stl").string()).info.encoding, "ascii");
+}
+
+// The file writer is the memory writer plus the file: the same bytes for every format and
+// encoding, and the bytes read back as the mesh.
+TEST(IoRoundTrip, MemoryWriterGivesTheFileBytes) {
+  TempDir dir;
+  const remora::Mesh mesh = octahedron();
+  for (const std::string name : {"octa.obj", "octa.off", "octa.ply", "octa.stl"}) {
+    for (const bool binary : {true, false}) {
+      SCOPED_TRACE(name + (binary ? " binary" : " ascii"));
+      const std::string path = (dir.path() / name).string();
+      const MeshFormat format = remora::format_from_path(path);
+      const std::string bytes =
+          remora::write_mesh_to_memory(mesh, format, name, {.binary = binary});
+      remora::write_mesh(path, mesh, {.binary = binary});
+      std::ifstream in(path, std::ios::binary);
+      const std::string file((std::istreambuf_iterator<char>(in)),
+                             std::istreambuf_iterator<char>());
+      EXPECT_EQ(bytes, file);
+      const SoupFile soup = remora::read_soup_from_memory(bytes, format, name);
+      EXPECT_EQ(soup.soup.num_polygons(), 8u);
+      EXPECT_EQ(soup.soup.points.size(), format == MeshFormat::Stl ? 24u : 6u);
+    }
+  }
+}
+
+TEST(IoRoundTrip, MemoryWriterRefusesNonFiniteCoordinates) {
+  remora::Mesh mesh = octahedron();
+  mesh.point(remora::VertexHandle(5))[2] = -std::numeric_limits<double>::infinity();
+  try {
+    remora::write_mesh_to_memory(mesh, MeshFormat::Obj, "upload.obj");
+    ADD_FAILURE();
+  } catch (const IoError& e) {
+    EXPECT_TRUE(contains(e.what(), "upload.obj")) << e.what();
+    EXPECT_TRUE(contains(e.what(), "vertex 5 has a non-finite z coordinate (-infinity)"))
+        << e.what();
+  }
 }
 
 TEST(IoRoundTrip, DeletedElementsAreLeftOut) {

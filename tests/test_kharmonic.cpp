@@ -151,8 +151,8 @@ TEST(KHarmonic, ConvergesToTheRadialSolutionsUnderRefinement) {
       }
       SCOPED_TRACE(testing::Message() << "k " << k << " " << to_string(w) << " errors " << errors[0]
                                       << " " << errors[1] << " " << errors[2]);
-      // Measured: k = 1 second order (errors 2.6e-3, 4.2e-4, 8.8e-5); k = 2 first order (6.3e-2,
-      // 3.8e-2, 2.2e-2), since the clamped condition u' = 0 comes from the constrained rings.
+      // k = 1 converges at second order; k = 2 at first order, since the clamped condition
+      // u' = 0 comes from the constrained rings.
       const double rate = k == 1 ? 3.0 : 1.6;
       EXPECT_LT(errors[1], errors[0] / rate);
       EXPECT_LT(errors[2], errors[1] / rate);

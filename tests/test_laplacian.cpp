@@ -13,6 +13,7 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 
+#include "remora/common/error.h"
 #include "remora/geometry/laplacian.h"
 #include "remora/geometry/measures.h"
 #include "remora/mesh/primitives.h"
@@ -136,6 +137,19 @@ TEST(LaplacianWeights, RightIsoscelesGridHandComputed) {
   EXPECT_NEAR(W.coeff(5, 5), -4.0, 1e-14);
   // Entries: both directions of every edge and the diagonal.
   EXPECT_EQ(W.nonZeros(), static_cast<Eigen::Index>(2 * mesh.n_edges() + mesh.n_vertices()));
+}
+
+// Unit edge weights give the graph Laplacian: -valence on the diagonal, 1 per edge.
+TEST(LaplacianWeights, WeightsMatrixOfUnitWeightsIsTheGraphLaplacian) {
+  const Mesh mesh = make_icosphere(2);
+  const Eigen::SparseMatrix<double> W =
+      weights_matrix(mesh, std::vector<double>(mesh.n_edges(), 1.0));
+  for (const VertexHandle v : mesh.vertices()) {
+    EXPECT_EQ(W.coeff(v.idx(), v.idx()), -static_cast<double>(mesh.valence(v)));
+    for (const VertexHandle w : mesh.vv_range(v)) EXPECT_EQ(W.coeff(v.idx(), w.idx()), 1.0);
+  }
+  EXPECT_EQ(W.nonZeros(), static_cast<Eigen::Index>(2 * mesh.n_edges() + mesh.n_vertices()));
+  EXPECT_THROW(weights_matrix(mesh, std::vector<double>(3, 1.0)), InvalidArgument);
 }
 
 TEST(LaplacianWeights, SymmetricWithZeroRowSums) {

@@ -483,10 +483,9 @@ TEST(LocateWalk, FlatNeedleGridMatchesBruteForce) {
 TEST(LocateWalk, BumpedNeedleGridEndsInALocalMinimum) {
   // Bent, the surface has creases along the needle strips. Above a concave one the distance has a
   // local minimum on each side, and the faces on the two sides share no vertex (the strip is in
-  // between), so a walk may stop on the farther side: then the result is still a local minimum
-  // over its neighbourhood, and only slightly farther than the global one (measured: 15 of 3000
-  // such queries, at most 1e-3 edge lengths farther; 0 of 3000 on the same surface without
-  // needles or without the bump).
+  // between), so a walk may stop on the farther side (rarely, and only here: not without the
+  // needles or without the bump): then the result is still a local minimum over its
+  // neighbourhood, and only slightly farther than the global one.
   const Mesh mesh =
       needle_grid([](double x, double y) { return 0.1 * std::sin(3.0 * x) * std::cos(2.0 * y); });
   std::mt19937 rng(41);

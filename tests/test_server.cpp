@@ -2,8 +2,8 @@
 // request is a 4xx with a JSON error; the editing round trip (load, region, transform, commit,
 // undo, redo, export) keeps its promises.
 #include <atomic>
-#include <chrono>
 #include <cmath>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -74,7 +74,16 @@ TEST(Server, EmptySessionAnswersStatusAndRefusesTheRest) {
       call(s, "POST", "/api/transform", R"({"handle": 0, "matrix": [1,0,0,0,0,1,0,0,0,0,1,0]})"),
       409, "no mesh");
   expect_error(call(s, "GET", "/api/nowhere"), 404, "no endpoint");
-  expect_error(call(s, "POST", "/api/status"), 405, "does not take POST");
+  // A wrong method is a 405 with a JSON body and the methods the path takes in Allow.
+  const HttpResponse post_status = call(s, "POST", "/api/status");
+  expect_error(post_status, 405, "/api/status does not take POST; use GET");
+  EXPECT_EQ(post_status.headers.count("Allow") ? post_status.headers.at("Allow") : "", "GET");
+  const HttpResponse put_region = call(s, "PUT", "/api/region");
+  expect_error(put_region, 405, "does not take PUT");
+  EXPECT_EQ(put_region.headers.count("Allow") ? put_region.headers.at("Allow") : "", "GET, POST");
+  const HttpResponse get_transform = call(s, "GET", "/api/transform");
+  expect_error(get_transform, 405, "does not take GET");
+  EXPECT_EQ(get_transform.headers.count("Allow") ? get_transform.headers.at("Allow") : "", "POST");
   expect_error(call(s, "POST", "/api/load", "", {{"name", "a.ply"}}), 400, "empty");
   expect_error(call(s, "POST", "/api/load", "x"), 400, "?name=");
   expect_error(call(s, "POST", "/api/load", "x", {{"name", "a.doc"}}), 400, "extension");
@@ -225,6 +234,29 @@ TEST(Server, EditRoundTripWithUndoAndRedo) {
         (baked[3 * static_cast<std::size_t>(v) + 2] - before[3 * static_cast<std::size_t>(v) + 2]) /
         double(handle.size());
   EXPECT_NEAR(baked_rise, 0.5, 0.02);
+}
+
+// The export is the mesh I/O layer's memory writer on the current result, byte for byte, and
+// needs no file: it works without a usable temporary folder.
+TEST(Server, ExportIsTheMemoryWriterAndNeedsNoTemporaryFolder) {
+  Session s;
+  const std::string off = sphere_off();
+  ASSERT_EQ(call(s, "POST", "/api/load", off, {{"name", "sphere.off"}}).status, 202);
+  s.wait();
+  const Mesh loaded = read_mesh_from_memory(off, MeshFormat::Off, "sphere.off").mesh;
+  const char* old_tmpdir = std::getenv("TMPDIR");
+  const std::string saved = old_tmpdir ? old_tmpdir : "";
+  ::setenv("TMPDIR", "/nonexistent/remora-no-temporary-folder", 1);
+  for (const std::string format : {"obj", "ply", "stl"}) {
+    const HttpResponse r = call(s, "GET", "/api/export", "", {{"format", format}});
+    EXPECT_EQ(r.status, 200) << format << ": " << r.body;
+    const std::string name = "edited." + format;
+    EXPECT_EQ(r.body, write_mesh_to_memory(loaded, format_from_path(name), name)) << format;
+  }
+  if (old_tmpdir)
+    ::setenv("TMPDIR", saved.c_str(), 1);
+  else
+    ::unsetenv("TMPDIR");
 }
 
 TEST(Server, BusyWhileWorkingAndSafeUnderConcurrentRequests) {

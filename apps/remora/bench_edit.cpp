@@ -1,9 +1,8 @@
-// `remora bench edit`: the editing kernel's goals (issue 5, docs/benchmarks.md): preprocessing
+// `remora bench edit`: the editing kernel's timings (docs/benchmarks.md): preprocessing
 // (base surface + remesh), set_region (map, factor, 3 + 4h basis functions, Phong encoding) for a
 // geodesic support of a given number of free base vertices, and the time per frame (blend +
 // decode, no solve) over a sequence of handle moves.
 #include <algorithm>
-#include <chrono>
 #include <iostream>
 
 #include <fmt/format.h>
@@ -11,6 +10,7 @@
 
 #include "commands.h"
 #include "remora/common/error.h"
+#include "remora/common/timer.h"
 #include "remora/geometry/measures.h"
 #include "remora/geometry/selection.h"
 #include "remora/mesh/io.h"
@@ -21,9 +21,104 @@ namespace remora::cli {
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
+struct BenchEditArgs {
+  std::string mesh = std::string(REMORA_REPO_DATA) + "/bunny.ply";
+  int support = 31000, frames = 60, k = 2, threads = 0;
+  std::string solver;
+  bool json = false;
+};
+
+struct BenchEditTimes {
+  double load_ms = 0, preprocess_ms = 0, set_region_ms = 0;
+  std::vector<double> frames; ///< sorted
+};
+
+/// A geodesic support around the vertex nearest the centroid, sized so that about `support`
+/// base vertices are free, and its innermost 3 % as the handle.
+void set_geodesic_region(Editor& editor, int support) {
+  const Mesh& mesh = editor.input();
+  const VertexHandle seed = central_vertex(mesh);
+  const double ratio = double(mesh.n_vertices()) / double(editor.base().n_vertices());
+  const auto wanted = static_cast<std::size_t>(
+      std::min(double(support) * 1.03, 0.9 * double(editor.base().n_vertices())) * ratio);
+  const std::vector<int> order = geodesic_order(mesh, seed, wanted);
+  const std::vector<int> handle(order.begin(),
+                                order.begin() + static_cast<long>(order.size() * 3 / 100 + 1));
+  editor.set_region(order, {handle});
+}
+
+/// positions() after each of `count` handle moves (a lift and a turn), in milliseconds, sorted.
+std::vector<double> time_frames(Editor& editor, int count) {
+  const double diagonal = bounding_box_diagonal(editor.input());
+  const Eigen::Vector3d center = editor.handle_center(0);
+  std::vector<double> frames;
+  for (int f = 1; f <= count; ++f) {
+    const double s = double(f) / count;
+    editor.set_transform(0, compose(translation(Eigen::Vector3d(0, 0.05 * s * diagonal, 0)),
+                                    rotation({1, 0, 0}, 0.5 * s, center)));
+    const auto t0 = Clock::now();
+    const Eigen::MatrixXd& p = editor.positions();
+    frames.push_back(ms_since(t0));
+    if (!p.allFinite()) throw NumericalError("bench edit: a frame has non-finite positions");
+  }
+  std::sort(frames.begin(), frames.end());
+  return frames;
+}
+
+void print_bench_edit(const BenchEditArgs& a, const EditReport& r, const BenchEditTimes& t) {
+  const double median = t.frames[t.frames.size() / 2];
+  if (a.json) {
+    nlohmann::json j = to_json(r);
+    j["bench"] = {{"mesh", a.mesh},
+                  {"load_ms", t.load_ms},
+                  {"preprocess_ms", t.preprocess_ms},
+                  {"set_region_ms", t.set_region_ms},
+                  {"frame_ms_median", median},
+                  {"frame_ms_max", t.frames.back()},
+                  {"frames", t.frames.size()}};
+    std::cout << j.dump(2) << "\n";
+    return;
+  }
+  std::cout << fmt::format("mesh {}: {} vertices, {} faces; base {} vertices\n", a.mesh,
+                           grouped(r.input_vertices), grouped(r.input_faces),
+                           grouped(r.base_vertices));
+  std::cout << fmt::format("preprocess {:.0f} ms (base {:.0f}, remesh {:.0f}, report {:.0f})\n",
+                           t.preprocess_ms, r.milliseconds.at("base"), r.milliseconds.at("remesh"),
+                           r.milliseconds.at("base report"));
+  std::cout << fmt::format(
+      "set_region {:.0f} ms for {} free base vertices, {} handle base "
+      "vertices, k = {} (assemble {:.0f}, factor {:.0f}, solve {:.0f}, "
+      "encode {:.0f} of {} vertices) with {}\n",
+      t.set_region_ms, grouped(r.free_base_vertices), grouped(r.handle_base_vertices.at(0)), a.k,
+      r.milliseconds.at("assemble"), r.milliseconds.at("factor"), r.milliseconds.at("solve"),
+      r.milliseconds.at("encode"), grouped(r.phong.encoded), r.solver);
+  std::cout << fmt::format("frame (blend + decode): median {:.2f} ms, max {:.2f} ms over {} "
+                           "frames\n",
+                           median, t.frames.back(), t.frames.size());
+}
+
+void run_bench_edit(const BenchEditArgs& a) {
+  BenchEditTimes t;
+  auto t0 = Clock::now();
+  const Mesh mesh = read_mesh(a.mesh).mesh;
+  t.load_ms = ms_since(t0);
+  EditorOptions options;
+  options.system.k = a.k;
+  options.solver.name = a.solver;
+  options.threads = a.threads;
+  ProgressLine progress;
+  options.progress = [&](std::string_view phase, int step, int steps) {
+    progress.update(phase, step, steps);
+  };
+  t0 = Clock::now();
+  Editor editor(mesh, options);
+  t.preprocess_ms = ms_since(t0);
+  progress.finish();
+  t0 = Clock::now();
+  set_geodesic_region(editor, a.support);
+  t.set_region_ms = ms_since(t0);
+  t.frames = time_frames(editor, a.frames);
+  print_bench_edit(a, editor.report(), t);
 }
 
 } // namespace
@@ -31,13 +126,7 @@ double ms_since(Clock::time_point t0) {
 void add_bench_edit_command(CLI::App& bench) {
   auto* cmd = bench.add_subcommand(
       "edit", "The editor: preprocessing, set_region and per-frame times on a geodesic support");
-  struct Args {
-    std::string mesh = std::string(REMORA_REPO_DATA) + "/bunny.ply";
-    int support = 31000, frames = 60, k = 2, threads = 0;
-    std::string solver;
-    bool json = false;
-  };
-  auto a = std::make_shared<Args>();
+  auto a = std::make_shared<BenchEditArgs>();
   cmd->add_option("mesh", a->mesh, "Mesh (default: the bundled bunny)");
   cmd->add_option("--support", a->support,
                   "Free base vertices wanted in the support (default 31000; capped at 90 % of "
@@ -50,81 +139,7 @@ void add_bench_edit_command(CLI::App& bench) {
   cmd->add_option("--threads", a->threads, "Worker threads (default: all)")
       ->check(CLI::NonNegativeNumber);
   cmd->add_flag("--json", a->json, "Print one JSON object");
-  cmd->callback([a] {
-    auto t0 = Clock::now();
-    const Mesh mesh = read_mesh(a->mesh).mesh;
-    const double load_ms = ms_since(t0);
-    EditorOptions options;
-    options.system.k = a->k;
-    options.solver.name = a->solver;
-    options.threads = a->threads;
-    ProgressLine progress;
-    options.progress = [&](std::string_view phase, int step, int steps) {
-      progress.update(phase, step, steps);
-    };
-    t0 = Clock::now();
-    Editor editor(mesh, options);
-    const double preprocess_ms = ms_since(t0);
-    progress.finish();
-
-    // A geodesic support around the vertex nearest the centroid, sized so that about
-    // `support` base vertices are free; the handle is its innermost 3 %.
-    const VertexHandle seed = central_vertex(mesh);
-    const double ratio = double(mesh.n_vertices()) / double(editor.base().n_vertices());
-    const auto wanted = static_cast<std::size_t>(
-        std::min(double(a->support) * 1.03, 0.9 * double(editor.base().n_vertices())) * ratio);
-    const std::vector<int> order = geodesic_order(mesh, seed, wanted);
-    const std::vector<int> handle(order.begin(),
-                                  order.begin() + static_cast<long>(order.size() * 3 / 100 + 1));
-    t0 = Clock::now();
-    editor.set_region(order, {handle});
-    const double set_region_ms = ms_since(t0);
-
-    const double diagonal = bounding_box_diagonal(mesh);
-    const Eigen::Vector3d center = editor.handle_center(0);
-    std::vector<double> frames;
-    for (int f = 1; f <= a->frames; ++f) {
-      const double s = double(f) / a->frames;
-      editor.set_transform(0, compose(translation(Eigen::Vector3d(0, 0.05 * s * diagonal, 0)),
-                                      rotation({1, 0, 0}, 0.5 * s, center)));
-      t0 = Clock::now();
-      const Eigen::MatrixXd& p = editor.positions();
-      frames.push_back(ms_since(t0));
-      if (!p.allFinite()) throw NumericalError("bench edit: a frame has non-finite positions");
-    }
-    std::vector<double> sorted = frames;
-    std::sort(sorted.begin(), sorted.end());
-    const double median = sorted[sorted.size() / 2];
-    const EditReport& r = editor.report();
-    if (a->json) {
-      nlohmann::json j = to_json(r);
-      j["bench"] = {{"mesh", a->mesh},
-                    {"load_ms", load_ms},
-                    {"preprocess_ms", preprocess_ms},
-                    {"set_region_ms", set_region_ms},
-                    {"frame_ms_median", median},
-                    {"frame_ms_max", sorted.back()},
-                    {"frames", frames.size()}};
-      std::cout << j.dump(2) << "\n";
-      return;
-    }
-    std::cout << fmt::format("mesh {}: {} vertices, {} faces; base {} vertices\n", a->mesh,
-                             grouped(r.input_vertices), grouped(r.input_faces),
-                             grouped(r.base_vertices));
-    std::cout << fmt::format("preprocess {:.0f} ms (base {:.0f}, remesh {:.0f}, report {:.0f})\n",
-                             preprocess_ms, r.milliseconds.at("base"), r.milliseconds.at("remesh"),
-                             r.milliseconds.at("base report"));
-    std::cout << fmt::format(
-        "set_region {:.0f} ms for {} free base vertices, {} handle base "
-        "vertices, k = {} (assemble {:.0f}, factor {:.0f}, solve {:.0f}, "
-        "encode {:.0f} of {} vertices) with {}\n",
-        set_region_ms, grouped(r.free_base_vertices), grouped(r.handle_base_vertices.at(0)), a->k,
-        r.milliseconds.at("assemble"), r.milliseconds.at("factor"), r.milliseconds.at("solve"),
-        r.milliseconds.at("encode"), grouped(r.phong.encoded), r.solver);
-    std::cout << fmt::format("frame (blend + decode): median {:.2f} ms, max {:.2f} ms over {} "
-                             "frames\n",
-                             median, sorted.back(), frames.size());
-  });
+  cmd->callback([a] { run_bench_edit(*a); });
 }
 
 } // namespace remora::cli

@@ -1,4 +1,4 @@
-// `remora bench serve`: the browser editor's latency (issue 6, docs/benchmarks.md): the time from
+// `remora bench serve`: the browser editor's latency (docs/benchmarks.md): the time from
 // sending a transform request to having the moved positions, over loopback HTTP against an
 // in-process `remora serve`, for a geodesic support of a given number of input vertices.
 #include <algorithm>
@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <memory>
 #include <sstream>
 #include <thread>
 
@@ -16,6 +17,7 @@
 #include "api.h"
 #include "commands.h"
 #include "remora/common/error.h"
+#include "remora/common/timer.h"
 #include "remora/geometry/selection.h"
 #include "remora/mesh/io.h"
 #include "session.h"
@@ -25,120 +27,152 @@
 
 namespace remora::cli {
 
+namespace {
+
+struct BenchServeArgs {
+  std::string mesh = std::string(REMORA_REPO_DATA) + "/bunny.ply";
+  int support = 15000, requests = 200;
+  bool json = false;
+};
+
+/// The body of a successful answer; throws Error naming `what` otherwise.
+std::string ok(const httplib::Result& r, const char* what) {
+  if (!r || r->status >= 300)
+    throw Error(fmt::format("bench serve: {} failed: {}", what,
+                            r ? r->body : httplib::to_string(r.error())));
+  return r->body;
+}
+
+/// An in-process `remora serve` API on a free loopback port and a client for it. The listener
+/// stops and is joined however the benchmark ends.
+class Loopback {
+public:
+  Loopback() {
+    http_.set_payload_max_length(limits_.max_upload_bytes + 1);
+    auto adapt = [this](const httplib::Request& req, httplib::Response& res) {
+      server::HttpRequest q{req.method, req.path, {}, req.body};
+      for (const auto& [key, value] : req.params) q.query[key] = value;
+      const server::HttpResponse r = server::handle_api(session_, q, limits_);
+      res.status = r.status;
+      for (const auto& [key, value] : r.headers) res.set_header(key, value);
+      res.set_content(r.body, r.content_type.c_str());
+    };
+    http_.Get(".*", adapt);
+    http_.Post(".*", adapt);
+    const int port = http_.bind_to_any_port("127.0.0.1");
+    if (port < 0) throw IoError("127.0.0.1", "bench serve: cannot listen on any port");
+    listener_ = std::thread([this] { http_.listen_after_bind(); });
+    client_ = std::make_unique<httplib::Client>("127.0.0.1", port);
+    client_->set_read_timeout(600, 0);
+  }
+  ~Loopback() {
+    http_.stop();
+    listener_.join();
+  }
+  Loopback(const Loopback&) = delete;
+  Loopback& operator=(const Loopback&) = delete;
+
+  httplib::Client& client() { return *client_; }
+
+  /// Polls the status until the session is not busy; throws the job's error.
+  nlohmann::json wait_ready() {
+    for (;;) {
+      const auto s = nlohmann::json::parse(ok(client_->Get("/api/status"), "status"));
+      if (s["state"] != "busy") {
+        if (s.contains("error")) throw Error("bench serve: " + s["error"].get<std::string>());
+        return s;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+  }
+
+private:
+  server::Session session_;
+  const server::ApiLimits limits_;
+  httplib::Server http_;
+  std::thread listener_;
+  std::unique_ptr<httplib::Client> client_;
+};
+
+/// Uploads the mesh and sets the region: a geodesic disc of `support` vertices around the vertex
+/// nearest the centroid, the handle its innermost 3 %. Returns the status.
+nlohmann::json load_with_region(Loopback& server, const std::string& path, int support) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw IoError(path, "cannot open the file");
+  std::ostringstream bytes;
+  bytes << in.rdbuf();
+  const std::string name = std::filesystem::path(path).filename().string();
+  ok(server.client().Post(("/api/load?name=" + name).c_str(), bytes.str(),
+                          "application/octet-stream"),
+     "load");
+  server.wait_ready();
+  const Mesh mesh = read_mesh(path).mesh;
+  const std::vector<int> disc =
+      geodesic_order(mesh, central_vertex(mesh), static_cast<std::size_t>(support));
+  const std::vector<int> handle(disc.begin(),
+                                disc.begin() + static_cast<long>(disc.size() * 3 / 100 + 1));
+  ok(server.client().Post("/api/region",
+                          nlohmann::json{{"support", disc}, {"handles", {handle}}}.dump(),
+                          "application/json"),
+     "region");
+  return server.wait_ready();
+}
+
+double quantile(std::vector<double> v, double q) {
+  std::sort(v.begin(), v.end());
+  return v[std::min(v.size() - 1, static_cast<std::size_t>(q * double(v.size())))];
+}
+
+void run_bench_serve(const BenchServeArgs& a) {
+  Loopback server;
+  const nlohmann::json status = load_with_region(server, a.mesh, a.support);
+  std::vector<double> round_trips, frames;
+  std::size_t floats = 0;
+  for (int i = 0; i < a.requests; ++i) {
+    const double s = 0.02 * std::sin(0.1 * i);
+    const nlohmann::json body = {{"handle", 0}, {"matrix", {1, 0, 0, s, 0, 1, 0, s, 0, 0, 1, 0}}};
+    const auto t0 = Clock::now();
+    const auto r = server.client().Post("/api/transform", body.dump(), "application/json");
+    const std::string positions = ok(r, "transform");
+    round_trips.push_back(ms_since(t0));
+    frames.push_back(std::stod(r->get_header_value("X-Frame-Ms")));
+    floats = positions.size() / sizeof(float);
+  }
+  const nlohmann::json result = {{"mesh", a.mesh},
+                                 {"support", status["region"]["support"]},
+                                 {"free_base_vertices", status["region"]["free_base_vertices"]},
+                                 {"movable_floats", floats},
+                                 {"round_trip_ms_median", quantile(round_trips, 0.5)},
+                                 {"round_trip_ms_p95", quantile(round_trips, 0.95)},
+                                 {"round_trip_ms_max", quantile(round_trips, 1.0)},
+                                 {"frame_ms_median", quantile(frames, 0.5)},
+                                 {"requests", a.requests}};
+  if (a.json) {
+    std::cout << result.dump(2) << "\n";
+    return;
+  }
+  std::cout << fmt::format(
+      "{}: support {} vertices ({} free on the base), {} positions per answer ({:.0f} KB)\n"
+      "transform request -> positions received: median {:.2f} ms, p95 {:.2f} ms, max {:.2f} ms "
+      "over {} requests (server frame {:.2f} ms)\n",
+      a.mesh, result["support"].get<std::size_t>(), result["free_base_vertices"].get<std::size_t>(),
+      floats / 3, double(floats * 4) / 1024, quantile(round_trips, 0.5),
+      quantile(round_trips, 0.95), quantile(round_trips, 1.0), a.requests, quantile(frames, 0.5));
+}
+
+} // namespace
+
 void add_bench_serve_command(CLI::App& bench) {
   auto* cmd = bench.add_subcommand(
       "serve", "The browser editor's latency: transform request to positions, on loopback");
-  struct Args {
-    std::string mesh = std::string(REMORA_REPO_DATA) + "/bunny.ply";
-    int support = 15000, requests = 200;
-    bool json = false;
-  };
-  auto a = std::make_shared<Args>();
+  auto a = std::make_shared<BenchServeArgs>();
   cmd->add_option("mesh", a->mesh, "Mesh (default: the bundled bunny)");
   cmd->add_option("--support", a->support, "Input vertices in the support (default 15000)")
       ->check(CLI::PositiveNumber);
   cmd->add_option("--requests", a->requests, "Transform requests to time (default 200)")
       ->check(CLI::PositiveNumber);
   cmd->add_flag("--json", a->json, "Print one JSON object");
-  cmd->callback([a] {
-    std::ifstream in(a->mesh, std::ios::binary);
-    if (!in) throw IoError(a->mesh, "cannot open the file");
-    std::ostringstream bytes;
-    bytes << in.rdbuf();
-
-    server::Session session;
-    const server::ApiLimits limits;
-    httplib::Server http;
-    http.set_payload_max_length(limits.max_upload_bytes + 1);
-    auto adapt = [&](const httplib::Request& req, httplib::Response& res) {
-      server::HttpRequest q{req.method, req.path, {}, req.body};
-      for (const auto& [key, value] : req.params) q.query[key] = value;
-      const server::HttpResponse r = server::handle_api(session, q, limits);
-      res.status = r.status;
-      for (const auto& [key, value] : r.headers) res.set_header(key, value);
-      res.set_content(r.body, r.content_type.c_str());
-    };
-    http.Get(".*", adapt);
-    http.Post(".*", adapt);
-    const int port = http.bind_to_any_port("127.0.0.1");
-    std::thread listener([&] { http.listen_after_bind(); });
-    httplib::Client client("127.0.0.1", port);
-    client.set_read_timeout(600, 0);
-    auto ok = [](const httplib::Result& r, const char* what) {
-      if (!r || r->status >= 300)
-        throw Error(fmt::format("bench serve: {} failed: {}", what,
-                                r ? r->body : httplib::to_string(r.error())));
-      return r->body;
-    };
-    auto wait_ready = [&] {
-      for (;;) {
-        const auto s = nlohmann::json::parse(ok(client.Get("/api/status"), "status"));
-        if (s["state"] != "busy") {
-          if (s.contains("error")) throw Error("bench serve: " + s["error"].get<std::string>());
-          return s;
-        }
-        std::this_thread::sleep_for(std::chrono::milliseconds(20));
-      }
-    };
-    const std::string name = std::filesystem::path(a->mesh).filename().string();
-    ok(client.Post(("/api/load?name=" + name).c_str(), bytes.str(), "application/octet-stream"),
-       "load");
-    wait_ready();
-    // The support: a geodesic disc around the vertex nearest the centroid; the handle its
-    // innermost 3 %.
-    const Mesh mesh = read_mesh(a->mesh).mesh;
-    const VertexHandle seed = central_vertex(mesh);
-    const std::vector<int> support =
-        geodesic_order(mesh, seed, static_cast<std::size_t>(a->support));
-    const std::vector<int> handle(
-        support.begin(), support.begin() + static_cast<long>(support.size() * 3 / 100 + 1));
-    ok(client.Post("/api/region",
-                   nlohmann::json{{"support", support}, {"handles", {handle}}}.dump(),
-                   "application/json"),
-       "region");
-    const auto status = wait_ready();
-
-    std::vector<double> round_trips, frames;
-    std::size_t floats = 0;
-    for (int i = 0; i < a->requests; ++i) {
-      const double s = 0.02 * std::sin(0.1 * i);
-      const nlohmann::json body = {{"handle", 0}, {"matrix", {1, 0, 0, s, 0, 1, 0, s, 0, 0, 1, 0}}};
-      const auto t0 = std::chrono::steady_clock::now();
-      const auto r = client.Post("/api/transform", body.dump(), "application/json");
-      const std::string& positions = ok(r, "transform");
-      round_trips.push_back(
-          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
-      frames.push_back(std::stod(r->get_header_value("X-Frame-Ms")));
-      floats = positions.size() / sizeof(float);
-    }
-    http.stop();
-    listener.join();
-    auto quantile = [](std::vector<double> v, double q) {
-      std::sort(v.begin(), v.end());
-      return v[std::min(v.size() - 1, static_cast<std::size_t>(q * double(v.size())))];
-    };
-    const nlohmann::json result = {{"mesh", a->mesh},
-                                   {"support", status["region"]["support"]},
-                                   {"free_base_vertices", status["region"]["free_base_vertices"]},
-                                   {"movable_floats", floats},
-                                   {"round_trip_ms_median", quantile(round_trips, 0.5)},
-                                   {"round_trip_ms_p95", quantile(round_trips, 0.95)},
-                                   {"round_trip_ms_max", quantile(round_trips, 1.0)},
-                                   {"frame_ms_median", quantile(frames, 0.5)},
-                                   {"requests", a->requests}};
-    if (a->json) {
-      std::cout << result.dump(2) << "\n";
-      return;
-    }
-    std::cout << fmt::format(
-        "{}: support {} vertices ({} free on the base), {} positions per answer ({:.0f} KB)\n"
-        "transform request -> positions received: median {:.2f} ms, p95 {:.2f} ms, max {:.2f} ms "
-        "over {} requests (server frame {:.2f} ms)\n",
-        a->mesh, result["support"].get<std::size_t>(),
-        result["free_base_vertices"].get<std::size_t>(), floats / 3, double(floats * 4) / 1024,
-        quantile(round_trips, 0.5), quantile(round_trips, 0.95), quantile(round_trips, 1.0),
-        a->requests, quantile(frames, 0.5));
-  });
+  cmd->callback([a] { run_bench_serve(*a); });
 }
 
 } // namespace remora::cli

@@ -1,9 +1,9 @@
-#include <chrono>
 #include <iostream>
 
 #include <spdlog/spdlog.h>
 
 #include "commands.h"
+#include "remora/common/timer.h"
 #include "remora/mesh/io.h"
 #include "report.h"
 
@@ -19,11 +19,9 @@ void add_convert_command(CLI::App& app) {
   cmd->add_flag("--ascii", *ascii, "Write PLY and STL as text instead of binary");
   cmd->callback([in, out, ascii] {
     format_from_path(*out); // fail on an unknown extension before the (maybe long) load
-    const auto t0 = std::chrono::steady_clock::now();
+    const auto t0 = Clock::now();
     const LoadResult loaded = read_mesh(*in);
-    spdlog::debug(
-        "loaded and repaired in {:.1f} ms",
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+    spdlog::debug("loaded and repaired in {:.1f} ms", ms_since(t0));
     print_load_report(std::cout, loaded.report);
     WriteOptions options;
     options.binary = !*ascii;

@@ -1,6 +1,5 @@
 // `remora edit`: one edit of the pipeline of paper Fig. 3 (multires/editor.h), described by an
 // EDIT.json file (multires/edit_request.h, docs/editing.md) or by quick flags.
-#include <chrono>
 #include <cmath>
 #include <fstream>
 #include <iostream>
@@ -11,8 +10,10 @@
 
 #include "commands.h"
 #include "remora/common/error.h"
+#include "remora/common/timer.h"
 #include "remora/geometry/measures.h"
 #include "remora/mesh/io.h"
+#include "remora/multires/detail_retention.h"
 #include "remora/multires/edit_request.h"
 #include "remora/multires/editor.h"
 #include "report.h"
@@ -20,11 +21,6 @@
 namespace remora::cli {
 
 namespace {
-
-using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
 
 /// "x,y,z[,w]" -> numbers; `what` names the flag in the message.
 std::vector<double> numbers(const std::string& text, std::size_t count, const std::string& what) {
@@ -128,196 +124,220 @@ void print_edit_report(std::ostream& os, const EditReport& r, double load_ms, do
       ms("solve"), ms("encode"), ms("frame"));
 }
 
+struct EditArgs {
+  std::string in, out, edit;
+  std::string support_sphere, handle_sphere, translate, rotate, scale;
+  int k = 0, threads = 0;
+  std::string solver, areas, details;
+  double base_smoothing = -1, base_feature_cap = -1, length_factor = -1;
+  bool no_remesh = false, report = false, json = false;
+};
+
+void add_edit_options(CLI::App* cmd, EditArgs& a) {
+  cmd->add_option("input", a.in, "Input mesh (.obj .off .ply .stl)")->required();
+  cmd->add_option("-o,--output", a.out, "Output mesh; the format follows the extension")
+      ->required();
+  auto* edit = cmd->add_option("--edit", a.edit,
+                               "EDIT.json: k, solver, support, handles and "
+                               "their transforms (docs/editing.md)");
+  auto* support = cmd->add_option("--support-sphere", a.support_sphere,
+                                  "x,y,z,r: the support is the vertices in this sphere");
+  auto* handle = cmd->add_option("--handle-sphere", a.handle_sphere,
+                                 "x,y,z,r: the handle is the vertices in this sphere (inside the "
+                                 "support)");
+  auto* translate =
+      cmd->add_option("--translate", a.translate, "dx,dy,dz: move the handle by this offset");
+  auto* rotate =
+      cmd->add_option("--rotate", a.rotate, "ax,ay,az,deg: rotate the handle about its centroid");
+  auto* scale =
+      cmd->add_option("--scale", a.scale, "sx,sy,sz: scale the handle about its centroid");
+  for (auto* quick : {support, handle, translate, rotate, scale}) quick->excludes(edit);
+  support->needs(handle);
+  handle->needs(support);
+  cmd->add_option("--k", a.k, "1 (membrane), 2 (thin plate, default), 3")->check(CLI::Range(1, 3));
+  cmd->add_option("--solver", a.solver,
+                  "Solver name (remora bench solvers lists them) or "
+                  "multigrid; default: the direct solver");
+  cmd->add_option("--areas", a.areas, "mean (default, symmetric), mixed, mixed-symmetric")
+      ->check(CLI::IsMember({"mean", "mixed", "mixed-symmetric"}));
+  cmd->add_option("--details", a.details, "normal (default, Phong), displacement, none")
+      ->check(CLI::IsMember({"normal", "displacement", "none"}));
+  cmd->add_option("--base-smoothing", a.base_smoothing,
+                  "Low-pass length of the base surface, in mean edge lengths (area-based on needle "
+                  "meshes; default 2)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--base-feature-cap", a.base_feature_cap,
+                  "The base filter's sigma at most this many times the part's local half-width, "
+                  "so thin tubes and small holes are not pinched (default 1; 0 = off)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--length-factor", a.length_factor,
+                  "Base remesh edge length = factor x the mean edge length (area-based on needle "
+                  "meshes; default 0.9)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_flag("--no-remesh", a.no_remesh,
+                "Solve on the input's own connectivity (the baseline the paper improves on)");
+  cmd->add_option("--threads", a.threads, "Worker threads (default: all)")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_flag("--report", a.report, "Print timings and quality figures");
+  cmd->add_flag("--json", a.json, "Print the report as one JSON object");
+}
+
+EditRequest read_edit_file(const std::string& path) {
+  std::ifstream file(path);
+  if (!file) throw IoError(path, "cannot open the edit file");
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(file);
+  } catch (const nlohmann::json::parse_error& e) {
+    throw IoError(path, fmt::format("not valid JSON: {}", e.what()));
+  }
+  try {
+    return parse_edit_request(j);
+  } catch (const InvalidArgument& e) {
+    throw InvalidArgument(fmt::format("{}: {}", path, e.what()));
+  }
+}
+
+/// The request of --edit, or of the quick flags (one spherical handle).
+EditRequest edit_request(const EditArgs& a) {
+  if (!a.edit.empty()) return read_edit_file(a.edit);
+  if (a.support_sphere.empty())
+    throw InvalidArgument("nothing to edit: give --edit EDIT.json, or --support-sphere and "
+                          "--handle-sphere with --translate, --rotate or --scale");
+  EditRequest request;
+  request.support = sphere_flag(a.support_sphere, "--support-sphere");
+  HandleSpec h;
+  h.region = sphere_flag(a.handle_sphere, "--handle-sphere");
+  if (!a.scale.empty()) {
+    const auto v = numbers(a.scale, 3, "--scale");
+    h.transform.scale = Eigen::Vector3d(v[0], v[1], v[2]);
+  }
+  if (!a.rotate.empty()) {
+    const auto v = numbers(a.rotate, 4, "--rotate");
+    h.transform.rotate_axis = Eigen::Vector3d(v[0], v[1], v[2]);
+    if (!(h.transform.rotate_axis->norm() > 0))
+      throw InvalidArgument("--rotate: the axis must not be zero");
+    h.transform.rotate_degrees = v[3];
+  }
+  if (!a.translate.empty()) {
+    const auto v = numbers(a.translate, 3, "--translate");
+    h.transform.translate = Eigen::Vector3d(v[0], v[1], v[2]);
+  }
+  request.handles.push_back(h);
+  return request;
+}
+
+/// The request's options, then the flags over them.
+EditorOptions editor_options(const EditRequest& request, const EditArgs& a) {
+  EditorOptions options;
+  apply_request_options(request, options);
+  if (a.k > 0) options.system.k = a.k;
+  if (!a.solver.empty()) options.solver.name = a.solver;
+  if (!a.areas.empty()) options.system.areas = parse_area_weights(a.areas);
+  if (!a.details.empty()) options.details = parse_detail_mode(a.details);
+  if (a.base_smoothing >= 0) options.base.smoothing = a.base_smoothing;
+  if (a.base_feature_cap >= 0) options.base.feature_cap = a.base_feature_cap;
+  if (a.length_factor > 0) options.remesh_options.length_factor = a.length_factor;
+  if (a.no_remesh) options.remesh = false;
+  options.threads = a.threads;
+  // The unsymmetric system needs a solver for it.
+  if (options.system.areas == AreaWeights::Mixed && options.solver.name.empty())
+    options.solver.name = "lu";
+  return options;
+}
+
+struct Selection {
+  std::vector<int> support;
+  std::vector<std::vector<int>> handles;
+};
+
+/// The request's regions on the loaded mesh; throws InvalidArgument for a region that selects
+/// nothing. Vertex ids in the request are the file's (the loader may drop or split vertices).
+Selection select_regions(EditRequest& request, const LoadResult& loaded, const std::string& in) {
+  const Mesh& mesh = loaded.mesh;
+  map_file_vertex_ids(request.support, loaded.source_vertex);
+  for (HandleSpec& h : request.handles) map_file_vertex_ids(h.region, loaded.source_vertex);
+  Selection s{select_region(mesh, request.support), {}};
+  if (s.support.empty()) {
+    const BoundingBox box = bounding_box(mesh);
+    throw InvalidArgument(fmt::format(
+        "the support ({}) selects no vertex of {}; its bounding box is ({:.6g}, {:.6g}, {:.6g}) "
+        "to ({:.6g}, {:.6g}, {:.6g})",
+        describe(request.support), in, box.min[0], box.min[1], box.min[2], box.max[0], box.max[1],
+        box.max[2]));
+  }
+  for (std::size_t j = 0; j < request.handles.size(); ++j) {
+    s.handles.push_back(select_region(mesh, request.handles[j].region));
+    if (s.handles.back().empty())
+      throw InvalidArgument(fmt::format("handle {} ({}) selects no vertex of {}", j,
+                                        describe(request.handles[j].region), in));
+  }
+  return s;
+}
+
+/// The figures after the edit: the largest move, and the detail retention in the support.
+void report_edit(const EditArgs& a, Editor& editor, const Selection& s, double load_ms) {
+  const Mesh& mesh = editor.input();
+  const Eigen::MatrixXd input = positions_matrix(mesh);
+  const Eigen::MatrixXd& output = editor.positions();
+  const double max_move =
+      (output - input).rowwise().norm().maxCoeff() / bounding_box_diagonal(mesh);
+  const double retention = detail_retention(editor, s.support);
+  if (a.json) {
+    nlohmann::json j = to_json(editor.report());
+    j["milliseconds"]["load"] = load_ms;
+    j["result"] = {
+        {"output", a.out}, {"max_move_relative", max_move}, {"detail_retention", retention}};
+    std::cout << j.dump(2) << "\n";
+    return;
+  }
+  print_edit_report(std::cout, editor.report(), load_ms, retention, max_move);
+  std::cout << "wrote " << a.out << "\n";
+}
+
+void run_edit(const EditArgs& a) {
+  format_from_path(a.out); // fail on an unknown extension before the long work
+  EditRequest request = edit_request(a);
+  EditorOptions options = editor_options(request, a);
+  const auto t0 = Clock::now();
+  const LoadResult loaded = read_mesh(a.in);
+  const double load_ms = ms_since(t0);
+  // Regions first: a bad selection should fail before the preprocessing.
+  const Selection s = select_regions(request, loaded, a.in);
+
+  ProgressLine progress;
+  options.progress = [&](std::string_view phase, int step, int steps) {
+    progress.update(phase, step, steps);
+  };
+  Editor editor(loaded.mesh, options);
+  progress.update("set_region", 0, 1);
+  editor.set_region(s.support, s.handles);
+  progress.finish();
+  for (std::size_t j = 0; j < request.handles.size(); ++j) {
+    const int h = static_cast<int>(j);
+    editor.set_transform(h,
+                         resolve_transform(request.handles[j].transform, editor.handle_center(h)));
+  }
+  const Mesh result = editor.result();
+  write_mesh(a.out, result);
+  if (a.report || a.json) {
+    report_edit(a, editor, s, load_ms);
+    return;
+  }
+  std::cout << "wrote " << a.out << " (" << grouped(result.n_vertices()) << " vertices, "
+            << grouped(result.n_faces()) << " faces; " << grouped(s.support.size())
+            << " in the support)\n";
+}
+
 } // namespace
 
 void add_edit_command(CLI::App& app) {
   auto* cmd = app.add_subcommand(
       "edit", "Deform a mesh: move, rotate or scale handles; the support bends k-harmonically "
               "and the details ride along (paper section 3)");
-  struct Args {
-    std::string in, out, edit;
-    std::string support_sphere, handle_sphere, translate, rotate, scale;
-    int k = 0, threads = 0;
-    std::string solver, areas, details;
-    double base_smoothing = -1, base_feature_cap = -1, length_factor = -1;
-    bool no_remesh = false, report = false, json = false;
-  };
-  auto a = std::make_shared<Args>();
-  cmd->add_option("input", a->in, "Input mesh (.obj .off .ply .stl)")->required();
-  cmd->add_option("-o,--output", a->out, "Output mesh; the format follows the extension")
-      ->required();
-  auto* edit = cmd->add_option("--edit", a->edit,
-                               "EDIT.json: k, solver, support, handles and "
-                               "their transforms (docs/editing.md)");
-  auto* support = cmd->add_option("--support-sphere", a->support_sphere,
-                                  "x,y,z,r: the support is the vertices in this sphere");
-  auto* handle = cmd->add_option("--handle-sphere", a->handle_sphere,
-                                 "x,y,z,r: the handle is the vertices in this sphere (inside the "
-                                 "support)");
-  auto* translate =
-      cmd->add_option("--translate", a->translate, "dx,dy,dz: move the handle by this offset");
-  auto* rotate =
-      cmd->add_option("--rotate", a->rotate, "ax,ay,az,deg: rotate the handle about its centroid");
-  auto* scale =
-      cmd->add_option("--scale", a->scale, "sx,sy,sz: scale the handle about its centroid");
-  for (auto* quick : {support, handle, translate, rotate, scale}) quick->excludes(edit);
-  support->needs(handle);
-  handle->needs(support);
-  cmd->add_option("--k", a->k, "1 (membrane), 2 (thin plate, default), 3")->check(CLI::Range(1, 3));
-  cmd->add_option("--solver", a->solver,
-                  "Solver name (remora bench solvers lists them) or "
-                  "multigrid; default: the direct solver");
-  cmd->add_option("--areas", a->areas, "mean (default, symmetric), mixed, mixed-symmetric")
-      ->check(CLI::IsMember({"mean", "mixed", "mixed-symmetric"}));
-  cmd->add_option("--details", a->details, "normal (default, Phong), displacement, none")
-      ->check(CLI::IsMember({"normal", "displacement", "none"}));
-  cmd->add_option("--base-smoothing", a->base_smoothing,
-                  "Low-pass length of the base surface, in mean edge lengths (area-based on needle "
-                  "meshes; default 2)")
-      ->check(CLI::NonNegativeNumber);
-  cmd->add_option("--base-feature-cap", a->base_feature_cap,
-                  "The base filter's sigma at most this many times the part's local half-width, "
-                  "so thin tubes and small holes are not pinched (default 1; 0 = off)")
-      ->check(CLI::NonNegativeNumber);
-  cmd->add_option("--length-factor", a->length_factor,
-                  "Base remesh edge length = factor x the mean edge length (area-based on needle "
-                  "meshes; default 0.9)")
-      ->check(CLI::PositiveNumber);
-  cmd->add_flag("--no-remesh", a->no_remesh,
-                "Solve on the input's own connectivity (the baseline the paper improves on)");
-  cmd->add_option("--threads", a->threads, "Worker threads (default: all)")
-      ->check(CLI::NonNegativeNumber);
-  cmd->add_flag("--report", a->report, "Print timings and quality figures");
-  cmd->add_flag("--json", a->json, "Print the report as one JSON object");
-  cmd->callback([a] {
-    format_from_path(a->out); // fail on an unknown extension before the long work
-    EditRequest request;
-    if (!a->edit.empty()) {
-      std::ifstream file(a->edit);
-      if (!file) throw IoError(a->edit, "cannot open the edit file");
-      nlohmann::json j;
-      try {
-        j = nlohmann::json::parse(file);
-      } catch (const nlohmann::json::parse_error& e) {
-        throw IoError(a->edit, fmt::format("not valid JSON: {}", e.what()));
-      }
-      try {
-        request = parse_edit_request(j);
-      } catch (const InvalidArgument& e) {
-        throw InvalidArgument(fmt::format("{}: {}", a->edit, e.what()));
-      }
-    } else {
-      if (a->support_sphere.empty())
-        throw InvalidArgument("nothing to edit: give --edit EDIT.json, or --support-sphere and "
-                              "--handle-sphere with --translate, --rotate or --scale");
-      request.support = sphere_flag(a->support_sphere, "--support-sphere");
-      HandleSpec h;
-      h.region = sphere_flag(a->handle_sphere, "--handle-sphere");
-      if (!a->scale.empty()) {
-        const auto v = numbers(a->scale, 3, "--scale");
-        h.transform.scale = Eigen::Vector3d(v[0], v[1], v[2]);
-      }
-      if (!a->rotate.empty()) {
-        const auto v = numbers(a->rotate, 4, "--rotate");
-        h.transform.rotate_axis = Eigen::Vector3d(v[0], v[1], v[2]);
-        if (!(h.transform.rotate_axis->norm() > 0))
-          throw InvalidArgument("--rotate: the axis must not be zero");
-        h.transform.rotate_degrees = v[3];
-      }
-      if (!a->translate.empty()) {
-        const auto v = numbers(a->translate, 3, "--translate");
-        h.transform.translate = Eigen::Vector3d(v[0], v[1], v[2]);
-      }
-      request.handles.push_back(h);
-    }
-
-    EditorOptions options;
-    apply_request_options(request, options);
-    if (a->k > 0) options.system.k = a->k;
-    if (!a->solver.empty()) options.solver.name = a->solver;
-    if (!a->areas.empty()) options.system.areas = parse_area_weights(a->areas);
-    if (!a->details.empty()) options.details = parse_detail_mode(a->details);
-    if (a->base_smoothing >= 0) options.base.smoothing = a->base_smoothing;
-    if (a->base_feature_cap >= 0) options.base.feature_cap = a->base_feature_cap;
-    if (a->length_factor > 0) options.remesh_options.length_factor = a->length_factor;
-    if (a->no_remesh) options.remesh = false;
-    options.threads = a->threads;
-    // The unsymmetric system needs a solver for it.
-    if (options.system.areas == AreaWeights::Mixed && options.solver.name.empty())
-      options.solver.name = "lu";
-
-    auto t0 = Clock::now();
-    const LoadResult loaded = read_mesh(a->in);
-    const double load_ms = ms_since(t0);
-    const Mesh& mesh = loaded.mesh;
-    // Vertex ids in the request are the file's; the loader may have dropped or split vertices.
-    map_file_vertex_ids(request.support, loaded.source_vertex);
-    for (HandleSpec& h : request.handles) map_file_vertex_ids(h.region, loaded.source_vertex);
-    // Regions first: a bad selection should fail before the preprocessing.
-    const std::vector<int> support_ids = select_region(mesh, request.support);
-    if (support_ids.empty()) {
-      const BoundingBox box = bounding_box(mesh);
-      throw InvalidArgument(fmt::format(
-          "the support ({}) selects no vertex of {}; its bounding box is ({:.6g}, {:.6g}, {:.6g}) "
-          "to ({:.6g}, {:.6g}, {:.6g})",
-          describe(request.support), a->in, box.min[0], box.min[1], box.min[2], box.max[0],
-          box.max[1], box.max[2]));
-    }
-    std::vector<std::vector<int>> handle_ids;
-    for (std::size_t j = 0; j < request.handles.size(); ++j) {
-      handle_ids.push_back(select_region(mesh, request.handles[j].region));
-      if (handle_ids.back().empty())
-        throw InvalidArgument(fmt::format("handle {} ({}) selects no vertex of {}", j,
-                                          describe(request.handles[j].region), a->in));
-    }
-
-    ProgressLine progress;
-    options.progress = [&](std::string_view phase, int step, int steps) {
-      progress.update(phase, step, steps);
-    };
-    Editor editor(mesh, options);
-    progress.update("set_region", 0, 1);
-    editor.set_region(support_ids, handle_ids);
-    progress.finish();
-    for (std::size_t j = 0; j < request.handles.size(); ++j) {
-      const int h = static_cast<int>(j);
-      editor.set_transform(
-          h, resolve_transform(request.handles[j].transform, editor.handle_center(h)));
-    }
-    const Mesh result = editor.result();
-    write_mesh(a->out, result);
-
-    if (!a->report && !a->json) {
-      std::cout << "wrote " << a->out << " (" << grouped(result.n_vertices()) << " vertices, "
-                << grouped(result.n_faces()) << " faces; " << grouped(support_ids.size())
-                << " in the support)\n";
-      return;
-    }
-    // Figures: the largest move, and the detail retention (spread of the result minus its
-    // low-pass over that of the input, in the support).
-    const Eigen::MatrixXd input = positions_matrix(mesh);
-    const Eigen::MatrixXd& output = editor.positions();
-    const double diagonal = bounding_box_diagonal(mesh);
-    const double max_move = (output - input).rowwise().norm().maxCoeff() / diagonal;
-    const Eigen::MatrixXd din = input - editor.low_pass(input);
-    const Eigen::MatrixXd dout = output - editor.low_pass(output);
-    double sin = 0, sout = 0;
-    for (const int v : support_ids) {
-      sin += din.row(v).squaredNorm();
-      sout += dout.row(v).squaredNorm();
-    }
-    const double retention = sin > 0 ? std::sqrt(sout / sin) : 1.0;
-    if (a->json) {
-      nlohmann::json j = to_json(editor.report());
-      j["milliseconds"]["load"] = load_ms;
-      j["result"] = {
-          {"output", a->out}, {"max_move_relative", max_move}, {"detail_retention", retention}};
-      std::cout << j.dump(2) << "\n";
-      return;
-    }
-    print_edit_report(std::cout, editor.report(), load_ms, retention, max_move);
-    std::cout << "wrote " << a->out << "\n";
-  });
+  auto a = std::make_shared<EditArgs>();
+  add_edit_options(cmd, *a);
+  cmd->callback([a] { run_edit(*a); });
 }
 
 } // namespace remora::cli

@@ -1,10 +1,10 @@
-#include <chrono>
 #include <iostream>
 
 #include <nlohmann/json.hpp>
 #include <spdlog/spdlog.h>
 
 #include "commands.h"
+#include "remora/common/timer.h"
 #include "remora/geometry/quality.h"
 #include "remora/mesh/io.h"
 #include "report.h"
@@ -18,14 +18,13 @@ void add_info_command(CLI::App& app) {
   cmd->add_option("file", *file, "Mesh file (.obj .off .ply .stl)")->required();
   cmd->add_flag("--json", *json, "Print one JSON object instead of a table");
   cmd->callback([file, json] {
-    const auto t0 = std::chrono::steady_clock::now();
+    const auto t0 = Clock::now();
     const LoadResult loaded = read_mesh(*file);
-    const auto t1 = std::chrono::steady_clock::now();
+    const double load_ms = ms_since(t0);
+    const auto t1 = Clock::now();
     const MeshQuality quality = mesh_quality(loaded.mesh);
-    spdlog::debug(
-        "loaded and repaired in {:.1f} ms, quality figures in {:.1f} ms",
-        std::chrono::duration<double, std::milli>(t1 - t0).count(),
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t1).count());
+    spdlog::debug("loaded and repaired in {:.1f} ms, quality figures in {:.1f} ms", load_ms,
+                  ms_since(t1));
     if (*json) {
       nlohmann::json j = to_json(quality);
       j["load"] = to_json(loaded.report);

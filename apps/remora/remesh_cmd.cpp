@@ -1,4 +1,3 @@
-#include <chrono>
 #include <cstdio>
 #include <iostream>
 #include <optional>
@@ -83,25 +82,19 @@ void print_remesh_report(std::ostream& os, const RemeshReport& r) {
   os << "time: " << times << "\n";
 }
 
-} // namespace
+struct RemeshArgs {
+  std::string in, out;
+  RemeshOptions options; ///< the library's defaults until a flag says otherwise
+  double low_pass = 0;   ///< σ of the base-surface filter, in mean edge lengths; 0 = off
+  LowPassOptions filter; ///< the editor's filter defaults but for the strength
+  std::string method = "newton";
+  std::string smoothing_target = "odt";
+  bool no_project = false, report = false, json = false;
+};
 
-void add_remesh_command(CLI::App& app) {
-  auto* cmd =
-      app.add_subcommand("remesh", "Isotropic, area-equalizing remesh (paper section 4) of a mesh");
-  struct Args {
-    std::string in, out;
-    RemeshOptions options; ///< the library's defaults until a flag says otherwise
-    double low_pass = 0;   ///< σ of the base-surface filter, in mean edge lengths; 0 = off
-    LowPassOptions filter; ///< the editor's filter defaults but for the strength
-    std::string method = "newton";
-    std::string smoothing_target = "odt";
-    bool no_project = false, report = false, json = false;
-  };
-  auto a = std::make_shared<Args>();
-  RemeshOptions& o = a->options;
-  cmd->add_option("input", a->in, "Input mesh (.obj .off .ply .stl)")->required();
-  cmd->add_option("-o,--output", a->out, "Output mesh; the format follows the extension")
-      ->required();
+// The cycles: target length and cycle counts.
+void add_cycle_options(CLI::App* cmd, RemeshArgs& a) {
+  RemeshOptions& o = a.options;
   auto* length = cmd->add_option("--length", o.target_length, "Target edge length l (absolute)")
                      ->check(CLI::PositiveNumber);
   cmd->add_option("--length-factor", o.length_factor,
@@ -123,20 +116,47 @@ void add_remesh_command(CLI::App& app) {
                   "fraction of the faces (1 = never)")
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
+}
+
+// The boundary and feature lines, and the threads.
+void add_boundary_options(CLI::App* cmd, RemeshArgs& a) {
+  RemeshOptions& o = a.options;
+  cmd->add_option("--boundary-spacing", o.boundary_spacing,
+                  "Spacing of the boundary vertices in l, set after the first cycle (<= 1: as the "
+                  "cycles leave it)")
+      ->check(CLI::Range(0.0, 4.0 / 3.0))
+      ->capture_default_str();
+  cmd->add_option("--corner-angle", o.corner_angle_deg,
+                  "A boundary or feature-line vertex where its curve turns by more than this "
+                  "many degrees (at the scale of l) is a corner and stays")
+      ->check(CLI::Range(0.0, 180.0))
+      ->capture_default_str();
+  cmd->add_option("--feature-angle", o.feature_angle_deg,
+                  "Keep the input's feature lines: edges whose faces' normals differ by more than "
+                  "this many degrees (0 = none)")
+      ->check(CLI::Range(0.0, 179.0))
+      ->capture_default_str();
+  cmd->add_option("--threads", o.threads, "Worker threads (default: all)")
+      ->check(CLI::NonNegativeNumber);
+}
+
+// The area equalization (paper §4) after the cycles.
+void add_equalization_options(CLI::App* cmd, RemeshArgs& a) {
+  RemeshOptions& o = a.options;
   cmd->add_option("--equalize", o.equalize_iterations, "Area-equalizing iterations")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   cmd->add_option("--lambda", o.lambda, "Damping of the area-equalizing update, in (0, 1]")
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
-  cmd->add_option("--method", a->method,
+  cmd->add_option("--method", a.method,
                   "Area equalization: newton (default) or gravity (the paper's update)")
       ->check(CLI::IsMember({"newton", "gravity"}));
   cmd->add_option("--smoothing", o.equalize_smoothing,
                   "newton: weight of the shape-keeping smoothing term")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
-  cmd->add_option("--smoothing-target", a->smoothing_target,
+  cmd->add_option("--smoothing-target", a.smoothing_target,
                   "newton: where the smoothing term pulls: odt (default; the one-ring's "
                   "circumcentres weighted by area) or centroid (weaker pull: try --smoothing 1.5)")
       ->check(CLI::IsMember({"odt", "centroid"}));
@@ -155,87 +175,91 @@ void add_remesh_command(CLI::App& app) {
   cmd->add_flag("!--no-boundary-equalization", o.equalize_boundary,
                 "newton: leave the boundary vertices' areas out of the fine-tuning (next to the "
                 "boundary, tangential smoothing only)");
-  cmd->add_option("--boundary-spacing", o.boundary_spacing,
-                  "Spacing of the boundary vertices in l, set after the first cycle (<= 1: as the "
-                  "cycles leave it)")
-      ->check(CLI::Range(0.0, 4.0 / 3.0))
-      ->capture_default_str();
-  cmd->add_option("--corner-angle", o.corner_angle_deg,
-                  "A boundary or feature-line vertex where its curve turns by more than this "
-                  "many degrees (at the scale of l) is a corner and stays")
-      ->check(CLI::Range(0.0, 180.0))
-      ->capture_default_str();
-  cmd->add_option("--feature-angle", o.feature_angle_deg,
-                  "Keep the input's feature lines: edges whose faces' normals differ by more than "
-                  "this many degrees (0 = none)")
-      ->check(CLI::Range(0.0, 179.0))
-      ->capture_default_str();
-  cmd->add_option("--threads", o.threads, "Worker threads (default: all)")
-      ->check(CLI::NonNegativeNumber);
-  cmd->add_flag("--no-project", a->no_project,
+}
+
+// Projection, report, and the low-pass filter of the editor's base surface.
+void add_output_options(CLI::App* cmd, RemeshArgs& a) {
+  cmd->add_flag("--no-project", a.no_project,
                 "Keep vertex updates in the tangent plane instead of projecting onto the input");
-  cmd->add_flag("--report", a->report, "Print quality figures, operation counts and timings");
-  cmd->add_flag("--json", a->json, "Print the report as one JSON object");
+  cmd->add_flag("--report", a.report, "Print quality figures, operation counts and timings");
+  cmd->add_flag("--json", a.json, "Print the report as one JSON object");
   auto* low_pass_flag =
       cmd->add_option(
-             "--low-pass", a->low_pass,
+             "--low-pass", a.low_pass,
              "Remesh the low-pass filtered surface instead, as `remora edit` builds its base "
              "(sigma in mean edge lengths; the editor's default is 2)")
           ->check(CLI::NonNegativeNumber);
-  cmd->add_option("--low-pass-cap", a->filter.feature_cap,
+  cmd->add_option("--low-pass-cap", a.filter.feature_cap,
                   "With --low-pass: sigma at most this many times the part's local half-width, so "
                   "thin tubes and small holes are not pinched (0 = one sigma everywhere)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str()
       ->needs(low_pass_flag);
-  cmd->callback([a] {
-    format_from_path(a->out); // fail on an unknown extension before the long work
-    LoadResult loaded = read_mesh(a->in);
-    std::optional<LowPassStats> low_pass;
-    if (a->low_pass > 0) {
-      // The editor's base surface S (multires/base_surface.h): same connectivity, smooth points.
-      LowPassOptions filter_options = a->filter;
-      filter_options.smoothing = a->low_pass;
-      filter_options.threads = a->options.threads;
-      LowPassFilter filter(loaded.mesh, filter_options);
-      set_positions(loaded.mesh, filter.apply(positions_matrix(loaded.mesh)));
-      low_pass = filter.stats();
-    }
-    RemeshOptions options = a->options;
-    options.equalization = a->method == "gravity" ? Equalization::Gravity : Equalization::Newton;
-    options.smoothing_target =
-        a->smoothing_target == "centroid" ? SmoothingTarget::Centroid : SmoothingTarget::Odt;
-    options.project = !a->no_project;
-    options.compute_report = a->report || a->json; // the figures cost 10-16 % of the time
-    ProgressLine progress;
-    options.progress = [&](std::string_view phase, int step, int steps) {
-      progress.update(phase, step, steps);
-    };
-    const RemeshResult result = remesh(loaded.mesh, options);
-    progress.finish();
-    write_mesh(a->out, result.mesh);
-    if (a->json) {
-      nlohmann::json j = to_json(result.report);
-      j["output"] = a->out;
-      if (low_pass)
-        j["low_pass"] = {{"sigma", low_pass->sigma},
-                         {"sigma_min", low_pass->sigma_min},
-                         {"sigma_capped_vertices", low_pass->capped},
-                         {"sigma_capped_loops", low_pass->capped_loops}};
-      std::cout << j.dump(2) << "\n";
-      return;
-    }
-    if (a->report && low_pass)
-      std::cout << fmt::format("low-pass filter: sigma {:.4g}", low_pass->sigma)
-                << (low_pass->capped + low_pass->capped_loops > 0
-                        ? ", " + capped_sigma_line(low_pass->capped, low_pass->sigma_min,
-                                                   low_pass->capped_loops)
-                        : std::string())
-                << "\n";
-    if (a->report) print_remesh_report(std::cout, result.report);
-    std::cout << "wrote " << a->out << " (" << grouped(result.mesh.n_vertices()) << " vertices, "
-              << grouped(result.mesh.n_faces()) << " faces)\n";
-  });
+}
+
+void run_remesh(const RemeshArgs& a) {
+  format_from_path(a.out); // fail on an unknown extension before the long work
+  LoadResult loaded = read_mesh(a.in);
+  std::optional<LowPassStats> low_pass;
+  if (a.low_pass > 0) {
+    // The editor's base surface S (multires/base_surface.h): same connectivity, smooth points.
+    LowPassOptions filter_options = a.filter;
+    filter_options.smoothing = a.low_pass;
+    filter_options.threads = a.options.threads;
+    LowPassFilter filter(loaded.mesh, filter_options);
+    set_positions(loaded.mesh, filter.apply(positions_matrix(loaded.mesh)));
+    low_pass = filter.stats();
+  }
+  RemeshOptions options = a.options;
+  options.equalization = a.method == "gravity" ? Equalization::Gravity : Equalization::Newton;
+  options.smoothing_target =
+      a.smoothing_target == "centroid" ? SmoothingTarget::Centroid : SmoothingTarget::Odt;
+  options.project = !a.no_project;
+  options.compute_report = a.report || a.json; // the figures take time: only when asked
+  ProgressLine progress;
+  options.progress = [&](std::string_view phase, int step, int steps) {
+    progress.update(phase, step, steps);
+  };
+  const RemeshResult result = remesh(loaded.mesh, options);
+  progress.finish();
+  write_mesh(a.out, result.mesh);
+  if (a.json) {
+    nlohmann::json j = to_json(result.report);
+    j["output"] = a.out;
+    if (low_pass)
+      j["low_pass"] = {{"sigma", low_pass->sigma},
+                       {"sigma_min", low_pass->sigma_min},
+                       {"sigma_capped_vertices", low_pass->capped},
+                       {"sigma_capped_loops", low_pass->capped_loops}};
+    std::cout << j.dump(2) << "\n";
+    return;
+  }
+  if (a.report && low_pass)
+    std::cout << fmt::format("low-pass filter: sigma {:.4g}", low_pass->sigma)
+              << (low_pass->capped + low_pass->capped_loops > 0
+                      ? ", " + capped_sigma_line(low_pass->capped, low_pass->sigma_min,
+                                                 low_pass->capped_loops)
+                      : std::string())
+              << "\n";
+  if (a.report) print_remesh_report(std::cout, result.report);
+  std::cout << "wrote " << a.out << " (" << grouped(result.mesh.n_vertices()) << " vertices, "
+            << grouped(result.mesh.n_faces()) << " faces)\n";
+}
+
+} // namespace
+
+void add_remesh_command(CLI::App& app) {
+  auto* cmd =
+      app.add_subcommand("remesh", "Isotropic, area-equalizing remesh (paper section 4) of a mesh");
+  auto a = std::make_shared<RemeshArgs>();
+  cmd->add_option("input", a->in, "Input mesh (.obj .off .ply .stl)")->required();
+  cmd->add_option("-o,--output", a->out, "Output mesh; the format follows the extension")
+      ->required();
+  add_cycle_options(cmd, *a);
+  add_equalization_options(cmd, *a);
+  add_boundary_options(cmd, *a);
+  add_output_options(cmd, *a);
+  cmd->callback([a] { run_remesh(*a); });
 }
 
 } // namespace remora::cli

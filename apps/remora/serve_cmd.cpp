@@ -48,8 +48,8 @@ void add_serve_command(CLI::App& app) {
   cmd->callback([a] {
     if (!std::filesystem::exists(std::filesystem::path(a->web_root) / "index.html"))
       throw InvalidArgument(fmt::format(
-          "the page's files are not in {} (index.html missing): build them with `make web`, or "
-          "give --web-root",
+          "the page's files are not in {0} (index.html missing): build them with `make build` "
+          "(into the build folder's web/) or `scripts/build_web.sh {0}`, or give --web-root",
           a->web_root));
     server::SessionOptions options;
     options.threads = a->threads;

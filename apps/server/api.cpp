@@ -41,6 +41,19 @@ public:
   using Error::Error;
 };
 
+/// A 405: the path exists but does not take the request's method; `allowed` is what it takes
+/// (the response's Allow header).
+class MethodNotAllowed : public Error {
+public:
+  MethodNotAllowed(const HttpRequest& request, std::string allowed)
+      : Error(fmt::format("{} does not take {}; use {}", request.path, request.method, allowed)),
+        allowed_(std::move(allowed)) {}
+  const std::string& allowed() const { return allowed_; }
+
+private:
+  std::string allowed_;
+};
+
 json parse_json(const HttpRequest& request, const ApiLimits& limits) {
   if (request.body.size() > limits.max_json_bytes)
     throw BadRequest(fmt::format("the JSON body has {} bytes; the limit is {}", request.body.size(),
@@ -120,13 +133,16 @@ HttpResponse transform(Session& session, const HttpRequest& request, const ApiLi
 
 HttpResponse dispatch(Session& session, const HttpRequest& q, const ApiLimits& limits) {
   const std::string& p = q.path;
-  const bool get = q.method == "GET", post = q.method == "POST";
-  auto need = [&](bool ok) {
-    if (!ok) throw std::invalid_argument("method");
+  const bool get = q.method == "GET";
+  // `method` or a 405 that names `allowed` (the methods the path takes).
+  auto need = [&](const std::string& method, const std::string& allowed) {
+    if (q.method != method) throw MethodNotAllowed(q, allowed);
   };
-  if (p == "/api/status") return need(get), json_response(200, session.status());
+  auto get_only = [&] { need("GET", "GET"); };
+  auto post_only = [&] { need("POST", "POST"); };
+  if (p == "/api/status") return get_only(), json_response(200, session.status());
   if (p == "/api/load") {
-    need(post);
+    post_only();
     const auto name = q.query.find("name");
     if (name == q.query.end() || name->second.empty())
       throw BadRequest("give the file name as ?name=mesh.ply (its extension names the format)");
@@ -137,25 +153,26 @@ HttpResponse dispatch(Session& session, const HttpRequest& q, const ApiLimits& l
     session.start_load(q.body, name->second);
     return json_response(202, session.status());
   }
-  if (p == "/api/mesh/positions") return need(get), binary_response(session.positions());
-  if (p == "/api/mesh/indices") return need(get), binary_response(session.indices());
-  if (p == "/api/movable") return need(get), binary_response(session.movable_vertices());
-  if (p == "/api/base/positions") return need(get), binary_response(session.base_positions());
-  if (p == "/api/base/indices") return need(get), binary_response(session.base_indices());
-  if (p == "/api/base/areas") return need(get), binary_response(session.base_areas());
+  if (p == "/api/mesh/positions") return get_only(), binary_response(session.positions());
+  if (p == "/api/mesh/indices") return get_only(), binary_response(session.indices());
+  if (p == "/api/movable") return get_only(), binary_response(session.movable_vertices());
+  if (p == "/api/base/positions") return get_only(), binary_response(session.base_positions());
+  if (p == "/api/base/indices") return get_only(), binary_response(session.base_indices());
+  if (p == "/api/base/areas") return get_only(), binary_response(session.base_areas());
   if (p == "/api/region" && get) return json_response(200, session.region());
-  if (p == "/api/region") return need(post), region(session, q, limits);
-  if (p == "/api/transform") return need(post), transform(session, q, limits);
-  if (p == "/api/commit") return need(post), session.commit(), json_response(200, session.status());
+  if (p == "/api/region") return need("POST", "GET, POST"), region(session, q, limits);
+  if (p == "/api/transform") return post_only(), transform(session, q, limits);
+  if (p == "/api/commit")
+    return post_only(), session.commit(), json_response(200, session.status());
   if (p == "/api/undo" || p == "/api/redo") {
-    need(post);
+    post_only();
     const bool done = p == "/api/undo" ? session.undo() : session.redo();
     json s = session.status();
     s["changed"] = done;
     return json_response(200, s);
   }
   if (p == "/api/export") {
-    need(get);
+    get_only();
     const auto f = q.query.find("format");
     const std::string format = f == q.query.end() ? "ply" : f->second;
     HttpResponse r;
@@ -172,8 +189,10 @@ HttpResponse dispatch(Session& session, const HttpRequest& q, const ApiLimits& l
 HttpResponse handle_api(Session& session, const HttpRequest& request, const ApiLimits& limits) {
   try {
     return dispatch(session, request, limits);
-  } catch (const std::invalid_argument&) {
-    return error_response(405, fmt::format("{} does not take {}", request.path, request.method));
+  } catch (const MethodNotAllowed& e) {
+    HttpResponse r = error_response(405, e.what());
+    r.headers["Allow"] = e.allowed();
+    return r;
   } catch (const BadRequest& e) {
     return error_response(400, e.what());
   } catch (const Busy& e) {
@@ -211,7 +230,6 @@ HttpResponse serve_static(const std::string& root, const std::string& path) {
                    : ext == ".mjs" ? "text/javascript; charset=utf-8"
                    : ext == ".css" ? "text/css; charset=utf-8"
                    : ext == ".png" ? "image/png"
-                   : ext == ".ply" ? "application/octet-stream"
                                    : "application/octet-stream";
   return r;
 }

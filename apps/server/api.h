@@ -4,8 +4,9 @@
 //
 // Mesh data travels as binary, little-endian: Float32 x, y, z per vertex, Uint32 vertex triples
 // per face, Uint32 ids. Everything else is JSON. A bad request gets a 4xx with {"error": "..."}:
-// 400 malformed (JSON shape, ids, numbers), 404 unknown path, 405 wrong method, 409 busy or not
-// ready, 413 too large. Never a 5xx for anything a client sends.
+// 400 malformed (JSON shape, ids, numbers), 404 unknown path, 405 wrong method (with an Allow
+// header naming the methods the path takes), 409 busy or not ready, 413 too large, 422 a solver
+// that failed on the request's region. Never a 5xx for anything a client sends.
 #pragma once
 
 #include <cstddef>

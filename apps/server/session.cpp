@@ -1,16 +1,11 @@
 #include "session.h"
 
 #include <algorithm>
-#include <atomic>
-#include <chrono>
-#include <cstdio>
-#include <filesystem>
-#include <fstream>
-#include <sstream>
-#include <unistd.h>
+#include <functional>
 
 #include <fmt/format.h>
 
+#include "remora/common/timer.h"
 #include "remora/geometry/measures.h"
 #include "remora/geometry/quality.h"
 #include "remora/linalg/kharmonic.h"
@@ -19,11 +14,6 @@
 namespace remora::server {
 
 namespace {
-
-using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
 
 struct RegionKey {
   std::vector<int> support;
@@ -159,7 +149,7 @@ void Session::wait() {
 
 void Session::start_load(std::string bytes, std::string name) {
   std::lock_guard lock(impl_->mutex);
-  const MeshFormat format = format_from_path(name); // IoError for an unknown extension, now
+  const MeshFormat format = format_from_path(name); // IoError for an unknown extension at once
   impl_->run("load", [this, bytes = std::move(bytes), name, format] {
     Impl& m = *impl_;
     const auto t0 = Clock::now();
@@ -400,16 +390,8 @@ std::string Session::export_mesh(const std::string& format) const {
     impl_->require_ready();
     result = impl_->region ? impl_->box->editor.result() : impl_->box->editor.input();
   }
-  // write_mesh() writes files atomically; a private temporary file gives the bytes.
-  const auto path = std::filesystem::temp_directory_path() /
-                    fmt::format("remora_export_{}_{}.{}", ::getpid(),
-                                std::hash<std::thread::id>{}(std::this_thread::get_id()), format);
-  write_mesh(path.string(), result);
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream bytes;
-  bytes << in.rdbuf();
-  std::filesystem::remove(path);
-  return bytes.str();
+  const std::string name = "edited." + format;
+  return write_mesh_to_memory(result, format_from_path(name), name);
 }
 
 } // namespace remora::server

@@ -78,7 +78,9 @@ public:
   std::vector<float> base_positions() const;
   std::vector<std::uint32_t> base_indices() const;
   std::vector<float> base_areas() const;
-  /// The current result in a file format ("obj", "ply", "stl").
+  /// The current result (the input before a region) as the bytes of a file in `format` ("obj",
+  /// "ply", "stl"; mesh/io.h's writer, binary PLY and STL). Throws InvalidArgument for another
+  /// format and Busy while nothing is loaded or the worker runs.
   std::string export_mesh(const std::string& format) const;
 
 private:

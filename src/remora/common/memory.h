@@ -6,9 +6,8 @@ namespace remora {
 /// Asks the C library to serve large allocations from its heap instead of fresh mappings, and
 /// not to hand freed memory back to the system before exit. A remesh of a million triangles
 /// allocates and frees hundreds of megabytes per phase (a compaction copies the whole mesh);
-/// with fresh mappings every page is faulted in again each time, which cost 15 % of a remesh of
-/// derived/igea_sub4.ply (10.0 s against 8.5 s; docs/benchmarks.md). The price: the process keeps
-/// its peak heap until it exits. Called once at the start of `remora` and of the benchmarks; a
+/// with fresh mappings every page is faulted in again each time (docs/benchmarks.md has the
+/// cost). The price: the process keeps its peak heap until it exits. Called once at the start of `remora` and of the benchmarks; a
 /// no-op where the C library is not glibc. Returns whether the settings took effect.
 bool keep_freed_memory();
 

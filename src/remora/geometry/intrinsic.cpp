@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "remora/common/error.h"
+#include "remora/geometry/laplacian.h"
 
 namespace remora {
 namespace {
@@ -63,19 +64,12 @@ struct IntrinsicMesh {
   }
 };
 
-} // namespace
+constexpr double kTolerance = 1e-12; // on cot α + cot β, which is scale-free
 
-IntrinsicLaplacian intrinsic_delaunay_laplacian(const Mesh& mesh, const IntrinsicOptions& options) {
-  if (!(options.mollify_factor > 0.0) || !std::isfinite(options.mollify_factor) ||
-      options.max_flips_per_edge < 0)
-    throw InvalidArgument(
-        fmt::format("intrinsic_delaunay_laplacian: mollify_factor {} must be finite and > 0, "
-                    "max_flips_per_edge {} >= 0",
-                    options.mollify_factor, options.max_flips_per_edge));
-  IntrinsicLaplacian out;
-  IntrinsicMesh im{mesh, std::vector<double>(mesh.n_edges(), 0.0)};
-  Mesh& m = im.mesh;
-
+// Mollify (Sharp & Crane 2020, §4.5): adds the smallest ε with l_i + l_j >= l_k + δ in every
+// face, δ = factor × the mean edge length, to every length; returns ε.
+double mollify(IntrinsicMesh& im, double factor) {
+  const Mesh& m = im.mesh;
   double total = 0.0;
   std::size_t count = 0;
   for (const EdgeHandle e : m.edges()) {
@@ -83,8 +77,7 @@ IntrinsicLaplacian intrinsic_delaunay_laplacian(const Mesh& mesh, const Intrinsi
     total += im.length[static_cast<std::size_t>(e.idx())];
     ++count;
   }
-  // Mollify: the smallest ε with l_i + l_j >= l_k + δ in every face once ε is added to all three.
-  const double delta = options.mollify_factor * (count > 0 ? total / double(count) : 0.0);
+  const double delta = factor * (count > 0 ? total / double(count) : 0.0);
   double epsilon = 0.0;
   for (const FaceHandle f : m.faces()) {
     const HalfedgeHandle h0 = m.halfedge_handle(f);
@@ -94,9 +87,13 @@ IntrinsicLaplacian intrinsic_delaunay_laplacian(const Mesh& mesh, const Intrinsi
       epsilon = std::max(epsilon, delta - (l[(k + 1) % 3] + l[(k + 2) % 3] - l[k]));
   }
   for (double& l : im.length) l += epsilon;
-  out.epsilon = epsilon;
+  return epsilon;
+}
 
-  // Flip to intrinsic Delaunay: every interior edge with cot α + cot β < 0.
+// Flips to intrinsic Delaunay: every interior edge with cot α + cot β < 0, at most
+// max_flips_per_edge times each; counts negative_before and flips in `out`.
+void flip_to_delaunay(IntrinsicMesh& im, int max_flips_per_edge, IntrinsicLaplacian& out) {
+  Mesh& m = im.mesh;
   std::vector<EdgeHandle> stack;
   std::vector<char> queued(m.n_edges(), 0);
   for (const EdgeHandle e : m.edges()) {
@@ -108,13 +105,12 @@ IntrinsicLaplacian intrinsic_delaunay_laplacian(const Mesh& mesh, const Intrinsi
     }
   }
   std::vector<int> flips_of(m.n_edges(), 0);
-  constexpr double kTolerance = 1e-12; // on cot α + cot β, which is scale-free
   while (!stack.empty()) {
     const EdgeHandle e = stack.back();
     stack.pop_back();
     queued[static_cast<std::size_t>(e.idx())] = 0;
     if (m.is_boundary(e) || !(im.weight(e) < -kTolerance)) continue;
-    if (flips_of[static_cast<std::size_t>(e.idx())] >= options.max_flips_per_edge) continue;
+    if (flips_of[static_cast<std::size_t>(e.idx())] >= max_flips_per_edge) continue;
     if (!m.is_flip_ok(e)) continue;
     const double l = im.flipped_length(e);
     m.flip(e);
@@ -132,9 +128,24 @@ IntrinsicLaplacian intrinsic_delaunay_laplacian(const Mesh& mesh, const Intrinsi
       }
     }
   }
+}
 
-  const auto n = static_cast<Eigen::Index>(m.n_vertices());
-  out.mass = Eigen::VectorXd::Zero(n);
+} // namespace
+
+IntrinsicLaplacian intrinsic_delaunay_laplacian(const Mesh& mesh, const IntrinsicOptions& options) {
+  if (!(options.mollify_factor > 0.0) || !std::isfinite(options.mollify_factor) ||
+      options.max_flips_per_edge < 0)
+    throw InvalidArgument(
+        fmt::format("intrinsic_delaunay_laplacian: mollify_factor {} must be finite and > 0, "
+                    "max_flips_per_edge {} >= 0",
+                    options.mollify_factor, options.max_flips_per_edge));
+  IntrinsicLaplacian out;
+  IntrinsicMesh im{mesh, std::vector<double>(mesh.n_edges(), 0.0)};
+  const Mesh& m = im.mesh;
+  out.epsilon = mollify(im, options.mollify_factor);
+  flip_to_delaunay(im, options.max_flips_per_edge, out);
+
+  out.mass = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(m.n_vertices()));
   for (const FaceHandle f : m.faces()) {
     const HalfedgeHandle h0 = m.halfedge_handle(f);
     const HalfedgeHandle h1 = m.next_halfedge_handle(h0);
@@ -142,14 +153,8 @@ IntrinsicLaplacian intrinsic_delaunay_laplacian(const Mesh& mesh, const Intrinsi
     const double third = area_from_lengths(im.len(h0), im.len(h1), im.len(h2)) / 3.0;
     for (const HalfedgeHandle h : {h0, h1, h2}) out.mass[m.to_vertex_handle(h).idx()] += third;
   }
-  Eigen::VectorXd diagonal = Eigen::VectorXd::Zero(n);
-  std::vector<char> has_edge(m.n_vertices(), 0);
-  std::vector<Eigen::Triplet<double>> triplets;
-  triplets.reserve(2 * m.n_edges() + m.n_vertices());
+  std::vector<double> weights(m.n_edges(), 0.0);
   for (const EdgeHandle e : m.edges()) {
-    const HalfedgeHandle h = m.halfedge_handle(e, 0);
-    const int i = m.from_vertex_handle(h).idx();
-    const int j = m.to_vertex_handle(h).idx();
     double w = im.weight(e);
     if (w < 0.0 && m.is_boundary(e)) {
       // A boundary edge cannot be flipped; an obtuse (up to 180°) corner opposite it would give
@@ -159,16 +164,9 @@ IntrinsicLaplacian intrinsic_delaunay_laplacian(const Mesh& mesh, const Intrinsi
     } else if (w < -kTolerance) {
       ++out.negative_after;
     }
-    triplets.emplace_back(i, j, w);
-    triplets.emplace_back(j, i, w);
-    diagonal[i] -= w;
-    diagonal[j] -= w;
-    has_edge[static_cast<std::size_t>(i)] = has_edge[static_cast<std::size_t>(j)] = 1;
+    weights[static_cast<std::size_t>(e.idx())] = w;
   }
-  for (Eigen::Index v = 0; v < n; ++v)
-    if (has_edge[static_cast<std::size_t>(v)]) triplets.emplace_back(v, v, diagonal[v]);
-  out.weights.resize(n, n);
-  out.weights.setFromTriplets(triplets.begin(), triplets.end()); // sums parallel intrinsic edges
+  out.weights = weights_matrix(m, weights); // sums parallel intrinsic edges
   return out;
 }
 

@@ -48,8 +48,8 @@ struct IntrinsicLaplacian {
 /// Builds the intrinsic Delaunay Laplacian of `mesh`. An edge whose flip OpenMesh refuses (the
 /// two opposite vertices already joined, which the intrinsic setting would allow) keeps its
 /// weight and is counted in negative_after. A boundary edge cannot be flipped: a negative weight
-/// there (an obtuse corner opposite it) is set to 0 and counted in clamped_boundary. Throws InvalidArgument when options are not finite
-/// and positive.
+/// there (an obtuse corner opposite it) is set to 0 and counted in clamped_boundary. Throws
+/// InvalidArgument when options are not finite and positive.
 IntrinsicLaplacian intrinsic_delaunay_laplacian(const Mesh& mesh,
                                                 const IntrinsicOptions& options = {});
 

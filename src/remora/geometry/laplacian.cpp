@@ -3,10 +3,12 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
 
+#include "remora/common/error.h"
 #include "remora/geometry/measures.h"
 
 namespace remora {
@@ -47,8 +49,11 @@ std::vector<double> edge_weights(const Mesh& mesh) {
 
 } // namespace
 
-Eigen::SparseMatrix<double> cotan_weights(const Mesh& mesh) {
-  const std::vector<double> weights = edge_weights(mesh);
+Eigen::SparseMatrix<double> weights_matrix(const Mesh& mesh, const std::vector<double>& weights) {
+  if (weights.size() != mesh.n_edges())
+    throw InvalidArgument("weights_matrix: " + std::to_string(weights.size()) +
+                          " edge weights for a mesh with " + std::to_string(mesh.n_edges()) +
+                          " edges");
   const auto n = static_cast<Eigen::Index>(mesh.n_vertices());
   Eigen::VectorXd diagonal = Eigen::VectorXd::Zero(n);
   std::vector<bool> has_edge(mesh.n_vertices(), false);
@@ -58,20 +63,24 @@ Eigen::SparseMatrix<double> cotan_weights(const Mesh& mesh) {
     const HalfedgeHandle h = mesh.halfedge_handle(e, 0);
     const int i = mesh.from_vertex_handle(h).idx();
     const int j = mesh.to_vertex_handle(h).idx();
-    const double w = weights[e.idx()];
+    const double w = weights[static_cast<std::size_t>(e.idx())];
     triplets.emplace_back(i, j, w);
     triplets.emplace_back(j, i, w);
     diagonal[i] -= w;
     diagonal[j] -= w;
-    has_edge[i] = true;
-    has_edge[j] = true;
+    has_edge[static_cast<std::size_t>(i)] = true;
+    has_edge[static_cast<std::size_t>(j)] = true;
   }
   for (Eigen::Index i = 0; i < n; ++i) {
-    if (has_edge[i]) triplets.emplace_back(i, i, diagonal[i]);
+    if (has_edge[static_cast<std::size_t>(i)]) triplets.emplace_back(i, i, diagonal[i]);
   }
   Eigen::SparseMatrix<double> W(n, n);
   W.setFromTriplets(triplets.begin(), triplets.end());
   return W;
+}
+
+Eigen::SparseMatrix<double> cotan_weights(const Mesh& mesh) {
+  return weights_matrix(mesh, edge_weights(mesh));
 }
 
 double laplacian_symmetry_defect(const Mesh& mesh, SymmetryRows rows) {

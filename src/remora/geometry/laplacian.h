@@ -13,6 +13,8 @@
 // Vertices are indexed by idx(); deleted faces are ignored.
 #pragma once
 
+#include <vector>
+
 #include <Eigen/SparseCore>
 
 #include "remora/mesh/mesh.h"
@@ -27,6 +29,12 @@ namespace remora {
 /// contributes nothing; every other face's cotangent is dot / |cross| of the corner's edge vectors,
 /// whose magnitude that threshold bounds by 1e12. No entry is NaN or Inf. W 1 = 0 to round-off.
 Eigen::SparseMatrix<double> cotan_weights(const Mesh& mesh);
+
+/// The symmetric n_vertices() x n_vertices() matrix of any edge weights, assembled like W above:
+/// W_ij = W_ji = weights[e.idx()] for every live edge e = (i, j), W_ii = -sum_j W_ij, with
+/// cotan_weights()'s structure (two edges joining the same vertices are summed). Throws
+/// InvalidArgument unless `weights` has n_edges() entries.
+Eigen::SparseMatrix<double> weights_matrix(const Mesh& mesh, const std::vector<double>& weights);
 
 /// How far the Laplacian is from its symmetric approximation of paper §5 (every A_i replaced by
 /// the mean area A_bar over the non-deleted, non-isolated vertices):

@@ -5,9 +5,9 @@
 // global one when q lies within a few edge lengths of the surface near `start` and away from the
 // surface's medial axis. Otherwise the walk stays on the sheet it started on: on a thin part it
 // does not jump to the other side, and near a concave crease, or inside a solid near a sharp
-// edge, it may stop on the side it reached first (measured for queries 0.5 edge lengths off
-// random faces: 0 to 0.2 % of them on icospheres, grids and scans, 2 % on the CAD part
-// conrod.stl). Deleted faces (status deleted, or halfedges without a face) are never entered.
+// edge, it may stop on the side it reached first (rare on smooth meshes, more frequent on CAD
+// parts with sharp creases). Deleted faces (status deleted, or halfedges without a face) are
+// never entered.
 // Thread-safe for concurrent calls on the same const mesh; nothing is allocated.
 #pragma once
 

@@ -62,7 +62,7 @@ std::vector<char> feature_edges(const Mesh& mesh, double angle_deg);
 /// base-surface filter its σ: the mean edge length, unless needles inflate it. The edge length
 /// of equilateral triangles with the mesh's area per (non-isolated) vertex, √(2A / (√3 V)), is
 /// within about 15 % of the mean edge length on a well-shaped mesh; when it is below 3/4 of it
-/// (every triangle of cad/blade.off is a needle: 0.46; cad/featuretype.STL 0.56), it is used.
+/// (a mesh of needles, whose long edges inflate the mean), it is used.
 struct LengthScale {
   double length = 0.0;
   double mean_edge = 0.0;

@@ -349,7 +349,8 @@ std::vector<int> reverse_cuthill_mckee(const Sparse& a) {
     degree[static_cast<std::size_t>(i)] = static_cast<int>(adj.size());
   }
   std::vector<int> level(static_cast<std::size_t>(n), -1);
-  // Breadth-first levels from `root` over unnumbered vertices; returns the last level's vertices.
+  // Breadth-first levels from `root` over its (unnumbered) component into `touched`; returns the
+  // depth of the last level. The caller resets `level` of the touched vertices to -1.
   auto levels_from = [&](int root, std::vector<int>& touched) {
     touched.clear();
     touched.push_back(root);
@@ -382,14 +383,9 @@ std::vector<int> reverse_cuthill_mckee(const Sparse& a) {
           best = u;
       for (int u : touched) level[static_cast<std::size_t>(u)] = -1;
       const int next_depth = levels_from(best, touched);
-      if (next_depth <= depth) {
-        for (int u : touched) level[static_cast<std::size_t>(u)] = -1;
-        break;
-      }
+      if (next_depth <= depth) break;
       root = best;
       depth = next_depth;
-      if (tries == 7)
-        for (int u : touched) level[static_cast<std::size_t>(u)] = -1;
     }
     for (int u : touched) level[static_cast<std::size_t>(u)] = -1;
     // Cuthill-McKee from the root.

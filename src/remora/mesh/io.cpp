@@ -344,22 +344,13 @@ SoupFile read_soup_from_memory(std::string_view bytes, MeshFormat format, const 
   throw IoError(name, "unknown mesh format");
 }
 
-void write_mesh(const std::string& path, const Mesh& mesh, const WriteOptions& options) {
-  namespace fs = std::filesystem;
-  // Everything that can be checked before touching the disk is checked first.
-  const MeshFormat format = format_from_path(path);
-  const fs::path target(path);
-  fs::path dir = target.parent_path();
-  if (dir.empty()) dir = ".";
-  std::error_code ec;
-  if (!fs::is_directory(dir, ec))
-    throw IoError(path, "cannot write: '" + dir.string() + "' is not an existing folder");
-
+std::string write_mesh_to_memory(const Mesh& mesh, MeshFormat format, const std::string& name,
+                                 const WriteOptions& options) {
   const io_detail::CompactMesh m = io_detail::compact(mesh);
   // A coordinate our readers reject must not reach a file.
   for (std::size_t i = 0; i < m.points.size(); ++i)
     if (!io_detail::is_finite(m.points[i]))
-      throw IoError(path,
+      throw IoError(name,
                     io_detail::non_finite_problem(m.points[i], "vertex " + std::to_string(i)) +
                         "; nothing was written");
   std::string bytes;
@@ -377,6 +368,20 @@ void write_mesh(const std::string& path, const Mesh& mesh, const WriteOptions& o
     io_detail::write_stl(m, options.binary, bytes);
     break;
   }
+  return bytes;
+}
+
+void write_mesh(const std::string& path, const Mesh& mesh, const WriteOptions& options) {
+  namespace fs = std::filesystem;
+  // Everything that can be checked before touching the disk is checked first.
+  const MeshFormat format = format_from_path(path);
+  const fs::path target(path);
+  fs::path dir = target.parent_path();
+  if (dir.empty()) dir = ".";
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec))
+    throw IoError(path, "cannot write: '" + dir.string() + "' is not an existing folder");
+  const std::string bytes = write_mesh_to_memory(mesh, format, path, options);
   write_atomically(path, dir / temporary_name(target), bytes);
 }
 

@@ -8,8 +8,9 @@
 // garbage content, a header whose counts disagree with the data, an empty mesh, an unknown
 // extension.
 //
-// Writing goes to a temporary file in the target's folder that is renamed over the target only
-// when everything was written; a failed write throws IoError and leaves no file behind.
+// Writing encodes the whole file in memory (write_mesh_to_memory(), one writer per format), then
+// write_mesh() puts it in a temporary file in the target's folder that is renamed over the target
+// only when everything was written; a failed write throws IoError and leaves no file behind.
 #pragma once
 
 #include <string>
@@ -51,10 +52,16 @@ struct WriteOptions {
   bool binary = true; ///< PLY and STL: binary (default) or ascii. OBJ and OFF are always text.
 };
 
-/// Writes `mesh` in the format of `path`'s extension, atomically (temporary file + rename).
-/// Text formats print coordinates with 17 significant digits, so doubles round-trip exactly;
-/// binary PLY stores doubles; STL stores 32-bit floats (the format allows nothing else).
-/// Throws IoError (unknown extension, unwritable folder, disk full).
+/// The whole file of `mesh` in `format`: the non-deleted vertices in index order (compact ids)
+/// and faces. Text formats print coordinates with 17 significant digits, so doubles round-trip
+/// exactly; binary PLY stores doubles; STL stores 32-bit floats (the format allows nothing else).
+/// Throws IoError naming `name` for a non-finite coordinate (which no reader would accept).
+std::string write_mesh_to_memory(const Mesh& mesh, MeshFormat format, const std::string& name,
+                                 const WriteOptions& options = {});
+
+/// Writes write_mesh_to_memory()'s bytes for the format of `path`'s extension, atomically
+/// (temporary file + rename): the file holds exactly those bytes or is left as it was.
+/// Throws IoError (unknown extension, unwritable folder, non-finite coordinate, disk full).
 void write_mesh(const std::string& path, const Mesh& mesh, const WriteOptions& options = {});
 
 } // namespace remora

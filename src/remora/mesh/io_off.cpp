@@ -30,34 +30,51 @@ void check_keyword(std::string_view keyword, const std::string& name, std::uint6
                 line);
 }
 
-} // namespace
+// The lines with content of the file: '#' comments and blank lines may appear anywhere.
+class ContentLines {
+public:
+  ContentLines(std::string_view bytes, const std::string& name) : lines_(bytes), name_(name) {}
 
-SoupFile read_off(std::string_view bytes, const std::string& name) {
-  check_text(bytes, name);
-  if (bytes.starts_with("\xEF\xBB\xBF")) bytes.remove_prefix(3); // UTF-8 byte-order mark
-
-  LineReader lines(bytes);
-  // The next line with content; '#' comments and blank lines may appear anywhere.
-  const auto next_content = [&lines](std::string_view& out) {
+  bool next(std::string_view& out) {
     std::string_view raw;
-    while (lines.next(raw)) {
+    while (lines_.next(raw)) {
       out = strip_comment(raw);
       if (!out.empty()) return true;
     }
     return false;
-  };
+  }
+  /// The line of record i of the `count` the header declares (`one`, `many`: "vertex",
+  /// "vertices"); throws IoError when the file ends before it.
+  std::string_view record(std::uint64_t i, std::uint64_t count, const char* one, const char* many) {
+    std::string_view out;
+    if (!next(out))
+      throw IoError(name_,
+                    "header declares " + count_of(count, one, many) + " but the file ends after " +
+                        std::to_string(i),
+                    lines_.line());
+    return out;
+  }
+  std::uint64_t line() const { return lines_.line(); }
 
+private:
+  LineReader lines_;
+  const std::string& name_;
+};
+
+struct Counts {
+  std::int64_t vertices = 0, faces = 0;
+};
+
+// The keyword and the counts, which may follow it on the same line.
+Counts read_header(ContentLines& lines, const std::string& name) {
   std::string_view line;
-  if (!next_content(line))
+  if (!lines.next(line))
     throw IoError(name, "no faces: the file is empty (no OFF header; an empty mesh cannot be "
                         "loaded)");
   const std::uint64_t header_line = lines.line();
-  std::string_view rest = line;
-  const std::string_view keyword = next_token(rest);
+  std::string_view counts = line;
+  const std::string_view keyword = next_token(counts);
   check_keyword(keyword, name, header_line);
-
-  // The counts may follow the keyword on the same line.
-  std::string_view counts = rest;
   std::string_view first = next_token(counts);
   if (first == "BINARY")
     throw IoError(name,
@@ -66,7 +83,7 @@ SoupFile read_off(std::string_view bytes, const std::string& name) {
                   header_line);
   std::uint64_t counts_line = header_line;
   if (first.empty()) {
-    if (!next_content(line))
+    if (!lines.next(line))
       throw IoError(name,
                     "the file ends after the '" + std::string(keyword) +
                         "' keyword, before the vertex and face counts",
@@ -80,81 +97,83 @@ SoupFile read_off(std::string_view bytes, const std::string& name) {
   if (second.empty() || !next_token(counts).empty())
     throw IoError(name, "expected the counts 'vertices faces edges' after the OFF keyword",
                   counts_line);
-  const std::int64_t nv = to_int(first, name, counts_line, "vertex count");
-  const std::int64_t nf = to_int(second, name, counts_line, "face count");
+  const Counts c{to_int(first, name, counts_line, "vertex count"),
+                 to_int(second, name, counts_line, "face count")};
   if (!third.empty()) to_int(third, name, counts_line, "edge count");
-  if (nv < 0 || nf < 0)
+  if (c.vertices < 0 || c.faces < 0)
     throw IoError(name, "negative vertex or face count in the header", counts_line);
-  if (nv >= static_cast<std::int64_t>(std::numeric_limits<std::uint32_t>::max()))
-    throw IoError(name, "too many vertices: " + std::to_string(nv), counts_line);
-  if (nf == 0)
+  if (c.vertices >= static_cast<std::int64_t>(std::numeric_limits<std::uint32_t>::max()))
+    throw IoError(name, "too many vertices: " + std::to_string(c.vertices), counts_line);
+  if (c.faces == 0)
     throw IoError(name,
-                  "no faces: the header declares " + std::to_string(nv) +
+                  "no faces: the header declares " + std::to_string(c.vertices) +
                       " vertices and 0 faces (an empty mesh cannot be loaded)",
                   counts_line);
+  return c;
+}
+
+// Face f's line: the corner count, then as many vertex indices below `nv`; whatever follows is a
+// face colour, read past.
+void read_face(std::string_view rest, std::uint64_t f, std::int64_t nv, const std::string& name,
+               std::uint64_t line_no, std::vector<std::uint32_t>& corners) {
+  const std::int64_t n = to_int(next_token(rest), name, line_no, "corner count of a face");
+  if (n < 3)
+    throw IoError(name,
+                  "face " + std::to_string(f) + " has " + std::to_string(n) +
+                      " corners; a face needs at least 3",
+                  line_no);
+  corners.clear();
+  for (std::int64_t k = 0; k < n; ++k) {
+    const std::string_view token = next_token(rest);
+    if (token.empty())
+      throw IoError(name,
+                    "face " + std::to_string(f) + " declares " + std::to_string(n) +
+                        " corners but the line has only " + std::to_string(k) + " vertex indices",
+                    line_no);
+    const std::int64_t index = to_int(token, name, line_no, "vertex index of a face");
+    if (index < 0 || index >= nv)
+      throw IoError(
+          name,
+          "face " + std::to_string(f) + " refers to vertex " + std::to_string(index) +
+              (index < 0 ? " (negative)" : " but the file has " + std::to_string(nv) + " vertices"),
+          line_no);
+    corners.push_back(static_cast<std::uint32_t>(index));
+  }
+}
+
+} // namespace
+
+SoupFile read_off(std::string_view bytes, const std::string& name) {
+  check_text(bytes, name);
+  if (bytes.starts_with("\xEF\xBB\xBF")) bytes.remove_prefix(3); // UTF-8 byte-order mark
+  ContentLines lines(bytes, name);
+  const Counts counts = read_header(lines, name);
 
   SoupFile result;
   result.info.format = "off";
   result.info.encoding = "ascii";
   PolygonSoup& soup = result.soup;
-  const auto vertex_count = static_cast<std::uint64_t>(nv);
-  const auto face_count = static_cast<std::uint64_t>(nf);
+  const auto vertex_count = static_cast<std::uint64_t>(counts.vertices);
+  const auto face_count = static_cast<std::uint64_t>(counts.faces);
   soup.points.reserve(reserve_count(vertex_count, bytes.size(), 6));
   soup.offsets.reserve(reserve_count(face_count, bytes.size(), 8) + 1);
   soup.indices.reserve(3 * reserve_count(face_count, bytes.size(), 8));
-
   for (std::uint64_t v = 0; v < vertex_count; ++v) {
-    if (!next_content(line))
-      throw IoError(name,
-                    "header declares " + count_of(vertex_count, "vertex", "vertices") +
-                        " but the file ends after " + std::to_string(v),
-                    lines.line());
-    rest = line;
+    std::string_view rest = lines.record(v, vertex_count, "vertex", "vertices");
     soup.points.push_back(parse_point(rest, v, name, lines.line()));
   }
-
   std::vector<std::uint32_t> corners;
   for (std::uint64_t f = 0; f < face_count; ++f) {
-    if (!next_content(line))
-      throw IoError(name,
-                    "header declares " + count_of(face_count, "face", "faces") +
-                        " but the file ends after " + std::to_string(f),
-                    lines.line());
-    const std::uint64_t line_no = lines.line();
-    rest = line;
-    const std::int64_t n = to_int(next_token(rest), name, line_no, "corner count of a face");
-    if (n < 3)
-      throw IoError(name,
-                    "face " + std::to_string(f) + " has " + std::to_string(n) +
-                        " corners; a face needs at least 3",
-                    line_no);
-    corners.clear();
-    for (std::int64_t k = 0; k < n; ++k) {
-      const std::string_view token = next_token(rest);
-      if (token.empty())
-        throw IoError(name,
-                      "face " + std::to_string(f) + " declares " + std::to_string(n) +
-                          " corners but the line has only " + std::to_string(k) + " vertex indices",
-                      line_no);
-      const std::int64_t index = to_int(token, name, line_no, "vertex index of a face");
-      if (index < 0 || index >= nv)
-        throw IoError(name,
-                      "face " + std::to_string(f) + " refers to vertex " + std::to_string(index) +
-                          (index < 0 ? " (negative)"
-                                     : " but the file has " + std::to_string(nv) + " vertices"),
-                      line_no);
-      corners.push_back(static_cast<std::uint32_t>(index));
-    }
-    // Whatever follows the indices is a face colour, read past.
+    const std::string_view line = lines.record(f, face_count, "face", "faces");
+    read_face(line, f, counts.vertices, name, lines.line(), corners);
     soup.add_polygon(corners.data(), corners.size());
   }
-
-  if (next_content(line))
+  std::string_view extra;
+  if (lines.next(extra))
     throw IoError(name,
                   "data continues after the " + count_of(face_count, "face", "faces") +
                       " the header declares",
                   lines.line());
-
   result.info.vertices_in_file = soup.points.size();
   result.info.faces_in_file = soup.num_polygons();
   return result;

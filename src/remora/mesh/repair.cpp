@@ -1,117 +1,24 @@
+// repair_soup(): the steps of repair.h in order, on one SoupRepairer; steps 1-3 are in
+// repair_weld.cpp and repair_triangulate.cpp.
 #include "remora/mesh/repair.h"
 
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstring>
 #include <limits>
 #include <numeric>
 #include <unordered_map>
-#include <unordered_set>
 
 #include "remora/common/error.h"
 #include "remora/mesh/build.h"
+#include "remora/mesh/repair_detail.h"
 
 namespace remora {
 
 namespace {
 
-using Tri = std::array<std::uint32_t, 3>;
-
-struct PointKey {
-  double x, y, z;
-  bool operator==(const PointKey& o) const { return x == o.x && y == o.y && z == o.z; }
-};
-
-struct PointKeyHash {
-  std::size_t operator()(const PointKey& k) const {
-    auto h = [](double d) {
-      std::uint64_t u;
-      static_assert(sizeof(u) == sizeof(d));
-      std::memcpy(&u, &d, sizeof(u));
-      return u;
-    };
-    std::uint64_t s = h(k.x) * 0x9E3779B97F4A7C15ULL;
-    s ^= h(k.y) + 0x7F4A7C159E3779B9ULL + (s << 6) + (s >> 2);
-    s ^= h(k.z) + 0x94D049BB133111EBULL + (s << 6) + (s >> 2);
-    return static_cast<std::size_t>(s ^ (s >> 31));
-  }
-};
-
-// -0.0 and +0.0 are the same point.
-PointKey key_of(const Vec3& p) {
-  return {p[0] + 0.0, p[1] + 0.0, p[2] + 0.0};
-}
-
-struct TriHash {
-  std::size_t operator()(const Tri& t) const {
-    std::uint64_t s = (std::uint64_t(t[0]) << 32 | t[1]) * 0x9E3779B97F4A7C15ULL;
-    s ^= t[2] * 0xBF58476D1CE4E5B9ULL;
-    return static_cast<std::size_t>(s ^ (s >> 29));
-  }
-};
-
-// Ear clipping of one planar-ish polygon, in its best-fit (Newell) plane. Keeps the polygon's
-// winding. Falls back to clipping the flattest corner when no proper ear exists (self-overlapping
-// or degenerate input), so it always produces n-2 triangles.
-void triangulate_polygon(const std::vector<Vec3>& pts, const std::vector<std::uint32_t>& poly,
-                         std::vector<Tri>& out) {
-  const std::size_t n = poly.size();
-  if (n == 3) {
-    out.push_back({poly[0], poly[1], poly[2]});
-    return;
-  }
-  Vec3 normal(0, 0, 0);
-  for (std::size_t i = 0; i < n; ++i) {
-    const Vec3& a = pts[poly[i]];
-    const Vec3& b = pts[poly[(i + 1) % n]];
-    normal[0] += (a[1] - b[1]) * (a[2] + b[2]);
-    normal[1] += (a[2] - b[2]) * (a[0] + b[0]);
-    normal[2] += (a[0] - b[0]) * (a[1] + b[1]);
-  }
-  // Drop the dominant axis of the normal; the 2D polygon then has the sign of that component.
-  int axis = 0;
-  for (int k = 1; k < 3; ++k)
-    if (std::abs(normal[k]) > std::abs(normal[axis])) axis = k;
-  const int u = (axis + 1) % 3, v = (axis + 2) % 3;
-  const double sign = normal[axis] >= 0 ? 1.0 : -1.0;
-  std::vector<std::array<double, 2>> p2(n);
-  for (std::size_t i = 0; i < n; ++i) p2[i] = {pts[poly[i]][u], sign * pts[poly[i]][v]};
-
-  auto cross = [&](std::size_t a, std::size_t b, std::size_t c) {
-    return (p2[b][0] - p2[a][0]) * (p2[c][1] - p2[a][1]) -
-           (p2[b][1] - p2[a][1]) * (p2[c][0] - p2[a][0]);
-  };
-  std::vector<std::size_t> ring(n);
-  std::iota(ring.begin(), ring.end(), std::size_t{0});
-  while (ring.size() > 3) {
-    const std::size_t m = ring.size();
-    std::size_t best = m; // index in ring of the ear to clip
-    double best_fallback = -std::numeric_limits<double>::infinity();
-    std::size_t fallback = 0;
-    for (std::size_t i = 0; i < m && best == m; ++i) {
-      const std::size_t a = ring[(i + m - 1) % m], b = ring[i], c = ring[(i + 1) % m];
-      const double turn = cross(a, b, c);
-      if (turn > best_fallback) {
-        best_fallback = turn;
-        fallback = i;
-      }
-      if (turn <= 0) continue; // reflex or flat corner
-      bool empty = true;
-      for (std::size_t j = 0; j < m && empty; ++j) {
-        const std::size_t q = ring[j];
-        if (q == a || q == b || q == c) continue;
-        if (cross(a, b, q) >= 0 && cross(b, c, q) >= 0 && cross(c, a, q) >= 0) empty = false;
-      }
-      if (empty) best = i;
-    }
-    if (best == m) best = fallback;
-    const std::size_t a = ring[(best + m - 1) % m], b = ring[best], c = ring[(best + 1) % m];
-    out.push_back({poly[a], poly[b], poly[c]});
-    ring.erase(ring.begin() + static_cast<std::ptrdiff_t>(best));
-  }
-  out.push_back({poly[ring[0]], poly[ring[1]], poly[ring[2]]});
-}
+using repair_detail::kNone;
+using repair_detail::Tri;
 
 struct DisjointSets {
   std::vector<std::uint32_t> parent;
@@ -172,122 +79,16 @@ private:
                                 std::to_string(nv) + " vertices");
   }
 
-  // Steps 1 and 2: unreferenced vertices are dropped, coincident ones merged (bit-identical ones
-  // first, then those closer than the tolerance). vmap_ maps soup
-  // vertex -> welded vertex (or kNone when unreferenced).
+  // Steps 1 and 2 (repair_weld.cpp). vmap_ maps soup vertex -> welded vertex (kNone when
+  // unreferenced).
   void weld() {
-    const std::size_t nv = soup_.points.size();
-    std::vector<char> used(nv, 0);
-    for (std::uint32_t i : soup_.indices) used[i] = 1;
-    vmap_.assign(nv, kNone);
-    std::unordered_map<PointKey, std::uint32_t, PointKeyHash> first;
-    if (options_.weld) first.reserve(nv);
-    for (std::size_t i = 0; i < nv; ++i) {
-      if (!used[i]) {
-        ++report_.unreferenced_vertices;
-        continue;
-      }
-      if (options_.weld) {
-        auto [it, inserted] =
-            first.try_emplace(key_of(soup_.points[i]), static_cast<std::uint32_t>(points_.size()));
-        if (!inserted) {
-          vmap_[i] = it->second;
-          ++report_.welded_vertices;
-          continue;
-        }
-      }
-      vmap_[i] = static_cast<std::uint32_t>(points_.size());
-      points_.push_back(soup_.points[i]);
-      source_.push_back(static_cast<std::uint32_t>(i));
-    }
-    if (options_.weld && options_.weld_tolerance > 0) weld_near();
-  }
-
-  // Step 2, second half: vertices within weld_tolerance x the bounding-box diagonal of an earlier
-  // (distinct) vertex are merged into it. Each vertex joins the first earlier survivor within
-  // reach, so the result follows the file's order and does not depend on hashing. Cells of 64
-  // tolerances: a vertex looks into a neighbouring cell only when it lies within reach of its
-  // face, so almost every vertex costs one lookup.
-  void weld_near() {
-    const std::size_t n = points_.size();
-    if (n < 2) return;
-    Vec3 lo(std::numeric_limits<double>::infinity()), hi(-std::numeric_limits<double>::infinity());
-    for (const Vec3& p : points_) {
-      if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2])) return;
-      lo.minimize(p);
-      hi.maximize(p);
-    }
-    const double tol = options_.weld_tolerance * (hi - lo).norm();
-    if (!(tol > 0)) return;
-    const double cell = 64 * tol;
-    struct Cell {
-      std::int64_t i, j, k;
-      bool operator==(const Cell& o) const { return i == o.i && j == o.j && k == o.k; }
-    };
-    struct CellHash {
-      std::size_t operator()(const Cell& c) const {
-        std::uint64_t s = std::uint64_t(c.i) * 0x9E3779B97F4A7C15ULL;
-        s ^= std::uint64_t(c.j) * 0xBF58476D1CE4E5B9ULL + (s << 6) + (s >> 2);
-        s ^= std::uint64_t(c.k) * 0x94D049BB133111EBULL + (s << 6) + (s >> 2);
-        return static_cast<std::size_t>(s ^ (s >> 31));
-      }
-    };
-    std::unordered_map<Cell, std::uint32_t, CellHash> head; // cell -> its last survivor
-    head.reserve(n);
-    std::vector<std::uint32_t> next(n, kNone); // survivors of a cell, newest first
-    std::vector<std::uint32_t> remap(n);
-    std::vector<Vec3> kept_points;
-    std::vector<std::uint32_t> kept_source;
-    kept_points.reserve(n);
-    kept_source.reserve(n);
-    std::vector<std::uint32_t> kept_index; // survivor (old index) -> new index
-    kept_index.assign(n, kNone);
-    for (std::uint32_t v = 0; v < n; ++v) {
-      const Vec3 q = (points_[v] - lo) / cell;
-      const Cell c{static_cast<std::int64_t>(std::floor(q[0])),
-                   static_cast<std::int64_t>(std::floor(q[1])),
-                   static_cast<std::int64_t>(std::floor(q[2]))};
-      // Per axis: this cell, and the neighbour whose face lies within reach.
-      std::array<std::array<int, 2>, 3> offsets{};
-      std::array<int, 3> count{};
-      const std::int64_t base[3] = {c.i, c.j, c.k};
-      for (int a = 0; a < 3; ++a) {
-        const double frac = (q[a] - static_cast<double>(base[a])) * cell;
-        offsets[a][count[a]++] = 0;
-        if (frac < tol)
-          offsets[a][count[a]++] = -1;
-        else if (cell - frac < tol)
-          offsets[a][count[a]++] = 1;
-      }
-      std::uint32_t found = kNone;
-      for (int x = 0; x < count[0]; ++x)
-        for (int y = 0; y < count[1]; ++y)
-          for (int z = 0; z < count[2]; ++z) {
-            auto it = head.find({c.i + offsets[0][x], c.j + offsets[1][y], c.k + offsets[2][z]});
-            if (it == head.end()) continue;
-            for (std::uint32_t s = it->second; s != kNone; s = next[s])
-              if (s < found && (points_[s] - points_[v]).sqrnorm() <= tol * tol) found = s;
-          }
-      if (found != kNone) {
-        remap[v] = kept_index[found];
-        ++report_.near_welded_vertices;
-        continue;
-      }
-      auto [it, inserted] = head.try_emplace(c, v);
-      if (!inserted) {
-        next[v] = it->second;
-        it->second = v;
-      }
-      kept_index[v] = static_cast<std::uint32_t>(kept_points.size());
-      remap[v] = kept_index[v];
-      kept_points.push_back(points_[v]);
-      kept_source.push_back(source_[v]);
-    }
-    if (kept_points.size() == n) return;
-    for (std::uint32_t& m : vmap_)
-      if (m != kNone) m = remap[m];
-    points_ = std::move(kept_points);
-    source_ = std::move(kept_source);
+    repair_detail::Welded w = repair_detail::weld_vertices(soup_, options_);
+    vmap_ = std::move(w.vertex_of);
+    points_ = std::move(w.points);
+    source_ = std::move(w.source);
+    report_.unreferenced_vertices += w.unreferenced;
+    report_.welded_vertices += w.welded;
+    report_.near_welded_vertices += w.near_welded;
   }
 
   // Step 3.
@@ -307,13 +108,12 @@ private:
         ++report_.polygons_triangulated;
         report_.triangles_added_by_triangulation += n - 3;
       }
-      triangulate_polygon(points_, poly, tris_);
+      repair_detail::triangulate_polygon(points_, poly, tris_);
     }
   }
 
-  // Step 4.
   // Step 4. A triangle listed more than once keeps one copy, unless it is a zero-thickness flap:
-  // copies glued to the surface along a single edge (cad/conrod.stl has three), of which one copy
+  // copies glued to the surface along a single edge (CAD exports carry them), of which one copy
   // kept would still be a fin on a non-manifold edge.
   void drop_degenerate_and_duplicates() {
     std::size_t out = 0;
@@ -505,79 +305,83 @@ private:
   // Step 6: decide which triangle pairs are joined across each edge, then give every fan of
   // joined triangles around a vertex its own copy of that vertex.
   void split_nonmanifold() {
-    const std::size_t nt = tris_.size();
-    DisjointSets corners(nt * 3); // corner id = 3*t + k
-    auto corner_of = [&](std::uint32_t t, std::uint32_t v) {
-      const Tri& tri = tris_[t];
-      const std::uint32_t k = tri[0] == v ? 0 : (tri[1] == v ? 1 : 2);
-      return 3 * t + k;
-    };
-    auto join = [&](const EdgeSide& a, const EdgeSide& b) {
-      const Tri& ta = tris_[a.tri];
-      const std::uint32_t v0 = ta[a.corner], v1 = ta[(a.corner + 1) % 3];
-      corners.unite(corner_of(a.tri, v0), corner_of(b.tri, v0));
-      corners.unite(corner_of(a.tri, v1), corner_of(b.tri, v1));
-    };
-    struct Around {
-      double angle;       // around the edge, from the first side
-      std::uint32_t side; // index into sides_
-      bool behind_ccw;    // the sector towards the next side counter-clockwise is behind the face
-    };
-    std::vector<Around> around;
+    DisjointSets corners(tris_.size() * 3); // corner id = 3*t + k
     for (std::size_t g = 0; g + 1 < group_start_.size(); ++g) {
       const std::uint32_t b = group_start_[g], e = group_start_[g + 1];
       if (e - b == 1) continue;
-      if (e - b == 2) {
-        if (forward(sides_[b]) != forward(sides_[b + 1]))
-          join(sides_[b], sides_[b + 1]);
-        else
-          ++report_.orientation_cuts;
+      if (e - b > 2) {
+        join_around_edge(corners, b, e);
         continue;
       }
-      // More than two triangles on one edge: order them by their angle around the edge and join
-      // angular neighbours of opposite direction, first across the sectors that lie behind both
-      // faces (inside a solid: two closed bodies touching along an edge stay two closed bodies),
-      // then any remaining neighbours; the rest are cut apart.
-      ++report_.nonmanifold_edges;
-      const std::uint64_t key = sides_[b].key;
-      const std::uint32_t va = static_cast<std::uint32_t>(key >> 32);
-      const std::uint32_t vb = static_cast<std::uint32_t>(key & 0xffffffffu);
-      const Vec3 axis = points_[vb] - points_[va];
-      const double axis2 = OpenMesh::dot(axis, axis);
-      Vec3 ref(0, 0, 0);
-      around.clear();
-      for (std::uint32_t i = b; i < e; ++i) {
-        const Tri& t = tris_[sides_[i].tri];
-        const std::uint32_t apex = t[(sides_[i].corner + 2) % 3];
-        Vec3 d = points_[apex] - points_[va];
-        if (axis2 > 0) d -= axis * (OpenMesh::dot(d, axis) / axis2);
-        if (i == b) ref = d;
-        const double angle =
-            std::atan2(OpenMesh::dot(OpenMesh::cross(ref, d), axis), OpenMesh::dot(ref, d));
-        const Vec3 normal =
-            OpenMesh::cross(points_[t[1]] - points_[t[0]], points_[t[2]] - points_[t[0]]);
-        const bool behind_ccw = OpenMesh::dot(normal, OpenMesh::cross(axis, d)) < 0;
-        around.push_back({angle, i, behind_ccw});
-      }
-      std::sort(around.begin(), around.end(),
-                [](const Around& x, const Around& y) { return x.angle < y.angle; });
-      const std::size_t m = around.size();
-      std::vector<char> paired(m, 0);
-      for (int pass = 0; pass < 2; ++pass)
-        for (std::size_t i = 0; i < m; ++i) {
-          const std::size_t j = (i + 1) % m;
-          if (paired[i] || paired[j] || (pass == 0 && !around[i].behind_ccw)) continue;
-          const EdgeSide &si = sides_[around[i].side], &sj = sides_[around[j].side];
-          if (forward(si) != forward(sj)) {
-            join(si, sj);
-            paired[i] = paired[j] = 1;
-          }
-        }
+      if (forward(sides_[b]) != forward(sides_[b + 1]))
+        join(corners, sides_[b], sides_[b + 1]);
+      else
+        ++report_.orientation_cuts;
     }
     out_points_ = points_;
     out_source_ = source_;
     vertex_taken_.assign(points_.size(), 0);
     assign_vertices(corners);
+  }
+
+  // Joins two sides of one edge: the corners of its two vertices in both triangles.
+  void join(DisjointSets& corners, const EdgeSide& a, const EdgeSide& b) const {
+    auto corner_of = [&](std::uint32_t t, std::uint32_t v) {
+      const Tri& tri = tris_[t];
+      const std::uint32_t k = tri[0] == v ? 0 : (tri[1] == v ? 1 : 2);
+      return 3 * t + k;
+    };
+    const Tri& ta = tris_[a.tri];
+    const std::uint32_t v0 = ta[a.corner], v1 = ta[(a.corner + 1) % 3];
+    corners.unite(corner_of(a.tri, v0), corner_of(b.tri, v0));
+    corners.unite(corner_of(a.tri, v1), corner_of(b.tri, v1));
+  }
+
+  // More than two triangles on one edge (sides_[b, e)): order them by their angle around the
+  // edge and join angular neighbours of opposite direction, first across the sectors that lie
+  // behind both faces (inside a solid: two closed bodies touching along an edge stay two closed
+  // bodies), then any remaining neighbours; the rest are cut apart.
+  void join_around_edge(DisjointSets& corners, std::uint32_t b, std::uint32_t e) {
+    ++report_.nonmanifold_edges;
+    struct Around {
+      double angle;       // around the edge, from the first side
+      std::uint32_t side; // index into sides_
+      bool behind_ccw;    // the sector towards the next side counter-clockwise is behind the face
+    };
+    const std::uint64_t key = sides_[b].key;
+    const std::uint32_t va = static_cast<std::uint32_t>(key >> 32);
+    const std::uint32_t vb = static_cast<std::uint32_t>(key & 0xffffffffu);
+    const Vec3 axis = points_[vb] - points_[va];
+    const double axis2 = OpenMesh::dot(axis, axis);
+    Vec3 ref(0, 0, 0);
+    std::vector<Around> around;
+    for (std::uint32_t i = b; i < e; ++i) {
+      const Tri& t = tris_[sides_[i].tri];
+      const std::uint32_t apex = t[(sides_[i].corner + 2) % 3];
+      Vec3 d = points_[apex] - points_[va];
+      if (axis2 > 0) d -= axis * (OpenMesh::dot(d, axis) / axis2);
+      if (i == b) ref = d;
+      const double angle =
+          std::atan2(OpenMesh::dot(OpenMesh::cross(ref, d), axis), OpenMesh::dot(ref, d));
+      const Vec3 normal =
+          OpenMesh::cross(points_[t[1]] - points_[t[0]], points_[t[2]] - points_[t[0]]);
+      const bool behind_ccw = OpenMesh::dot(normal, OpenMesh::cross(axis, d)) < 0;
+      around.push_back({angle, i, behind_ccw});
+    }
+    std::sort(around.begin(), around.end(),
+              [](const Around& x, const Around& y) { return x.angle < y.angle; });
+    const std::size_t m = around.size();
+    std::vector<char> paired(m, 0);
+    for (int pass = 0; pass < 2; ++pass)
+      for (std::size_t i = 0; i < m; ++i) {
+        const std::size_t j = (i + 1) % m;
+        if (paired[i] || paired[j] || (pass == 0 && !around[i].behind_ccw)) continue;
+        const EdgeSide &si = sides_[around[i].side], &sj = sides_[around[j].side];
+        if (forward(si) != forward(sj)) {
+          join(corners, si, sj);
+          paired[i] = paired[j] = 1;
+        }
+      }
   }
 
   // Each class of corners around a vertex becomes one output vertex: the first class keeps the
@@ -700,8 +504,6 @@ private:
     return result;
   }
 
-  static constexpr std::uint32_t kNone = std::numeric_limits<std::uint32_t>::max();
-
   const PolygonSoup& soup_;
   const RepairOptions& options_;
   RepairReport report_;
@@ -714,7 +516,6 @@ private:
   std::vector<Vec3> out_points_;
   std::vector<std::uint32_t> out_source_;
   std::vector<char> vertex_taken_;     // output vertex used by a triangle
-  std::vector<char> vertex_split_;     // welded vertex was split
   std::vector<std::uint32_t> copy_of_; // for copies (index - points_.size()): the welded vertex
 };
 

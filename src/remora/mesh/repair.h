@@ -52,7 +52,8 @@ struct RepairReport {
   std::size_t orphaned_vertices = 0; ///< left without a triangle once dropped ones were removed
   // Faces: triangles_in = polygons_in + triangles_added_by_triangulation
   //                     = faces_loaded + dropped_repeated_vertex + dropped_duplicate +
-  //                     dropped_degenerate_polygon.
+  //                       dropped_flap + dropped_degenerate_polygon (= faces_loaded +
+  //                       faces_dropped()).
   std::size_t polygons_triangulated = 0;            ///< polygons with more than three corners
   std::size_t triangles_added_by_triangulation = 0; ///< extra triangles they became
   std::size_t dropped_degenerate_polygon = 0;       ///< polygons with fewer than three corners

@@ -68,6 +68,135 @@ Eigen::VectorXd smoothing_field(const Mesh& mesh, double sigma, const LowPassOpt
   return field;
 }
 
+namespace {
+
+using Sparse = Eigen::SparseMatrix<double>;
+
+// Edge weights times σ_i σ_j, the diagonal again minus the row's sum.
+void scale_by_field(Sparse& w, const Eigen::VectorXd& field) {
+  for (int k = 0; k < w.outerSize(); ++k) {
+    double sum = 0.0;
+    double* diagonal = nullptr;
+    for (Sparse::InnerIterator it(w, k); it; ++it) {
+      if (it.row() == it.col()) {
+        diagonal = &it.valueRef();
+      } else {
+        it.valueRef() *= field[it.row()] * field[it.col()];
+        sum += it.value();
+      }
+    }
+    if (diagonal) *diagonal = -sum;
+  }
+}
+
+// Rows: interior vertices, then boundary ones; each vertex's place in its own block.
+struct RowBlocks {
+  std::vector<char> on_boundary;   ///< per vertex
+  std::vector<Eigen::Index> place; ///< per vertex, its row in its block
+  std::vector<Eigen::Index> interior, boundary;
+};
+
+RowBlocks row_blocks(const Mesh& mesh) {
+  const auto n = static_cast<std::size_t>(mesh.n_vertices());
+  RowBlocks rows;
+  rows.on_boundary.assign(n, 0);
+  rows.place.resize(n);
+  for (std::size_t i = 0; i < n; ++i) {
+    const VertexHandle v(static_cast<int>(i));
+    // Isolated vertices count as interior (OpenMesh calls them boundary).
+    rows.on_boundary[i] = !mesh.is_isolated(v) && mesh.is_boundary(v);
+    auto& list = rows.on_boundary[i] ? rows.boundary : rows.interior;
+    rows.place[i] = static_cast<Eigen::Index>(list.size());
+    list.push_back(static_cast<Eigen::Index>(i));
+  }
+  return rows;
+}
+
+// The interior system (M − tW)_II into `a`, its mass into `mass_out`, and the triplets of t W_IB
+// (the boundary's values) into `couple`; `w` is already scaled by what `scale` leaves out. A
+// closed mesh has no boundary block: its matrix is built in place, faster than from triplets.
+void interior_system(const Sparse& w, const Eigen::VectorXd& mass, double scale,
+                     const RowBlocks& rows, Sparse& a, Eigen::VectorXd& mass_out,
+                     std::vector<Eigen::Triplet<double>>& couple) {
+  const auto ni = static_cast<Eigen::Index>(rows.interior.size());
+  mass_out.resize(ni);
+  if (rows.boundary.empty()) {
+    mass_out = mass;
+    a = -scale * w;
+    for (Eigen::Index i = 0; i < ni; ++i) a.coeffRef(i, i) += mass_out[i];
+    a.makeCompressed();
+    return;
+  }
+  auto is_boundary = [&](Eigen::Index i) {
+    return rows.on_boundary[static_cast<std::size_t>(i)] != 0;
+  };
+  std::vector<Eigen::Triplet<double>> inner;
+  for (int k = 0; k < w.outerSize(); ++k)
+    for (Sparse::InnerIterator it(w, k); it; ++it) {
+      const Eigen::Index r = it.row(), c = it.col();
+      if (is_boundary(r)) continue;
+      const auto br = rows.place[static_cast<std::size_t>(r)];
+      const auto bc = rows.place[static_cast<std::size_t>(c)];
+      if (is_boundary(c))
+        couple.emplace_back(br, bc, scale * it.value());
+      else
+        inner.emplace_back(br, bc, -scale * it.value());
+    }
+  for (Eigen::Index i = 0; i < ni; ++i) {
+    mass_out[i] = mass[rows.interior[static_cast<std::size_t>(i)]];
+    inner.emplace_back(i, i, mass_out[i]);
+  }
+  a.resize(ni, ni);
+  a.setFromTriplets(inner.begin(), inner.end());
+}
+
+// The loops' curve system (M_b − W_b, W_b of weight σ²/length per boundary edge, M_b half the
+// adjacent lengths) over the boundary block, its mass into `mass`; each loop's σ is capped by
+// feature_cap × its radius (perimeter / 2π), counted in `capped_loops`. Lengths are floored for
+// coincident boundary vertices; each boundary vertex has exactly two boundary neighbours.
+Sparse loop_system(const Mesh& mesh, const RowBlocks& rows, double sigma_max, double feature_cap,
+                   Eigen::VectorXd& mass, std::size_t& capped_loops) {
+  const auto nb = static_cast<Eigen::Index>(rows.boundary.size());
+  const double floor = 1e-9 * sigma_max;
+  std::vector<Eigen::Triplet<double>> curve;
+  mass = Eigen::VectorXd::Zero(nb);
+  std::vector<char> done(mesh.n_halfedges(), 0);
+  std::vector<HalfedgeHandle> loop;
+  for (auto start : mesh.halfedges()) {
+    if (!mesh.is_boundary(start) || done[static_cast<std::size_t>(start.idx())]) continue;
+    loop.clear();
+    double perimeter = 0.0;
+    for (HalfedgeHandle h = start; !done[static_cast<std::size_t>(h.idx())];
+         h = mesh.next_halfedge_handle(h)) {
+      done[static_cast<std::size_t>(h.idx())] = 1;
+      loop.push_back(h);
+      perimeter += mesh.calc_edge_length(h);
+    }
+    const double sigma =
+        feature_cap > 0.0 ? std::min(sigma_max, feature_cap * perimeter / (2.0 * std::numbers::pi))
+                          : sigma_max;
+    capped_loops += sigma < sigma_max ? 1 : 0;
+    for (const HalfedgeHandle h : loop) {
+      const auto i = rows.place[static_cast<std::size_t>(mesh.from_vertex_handle(h).idx())];
+      const auto j = rows.place[static_cast<std::size_t>(mesh.to_vertex_handle(h).idx())];
+      const double length = std::max(mesh.calc_edge_length(h), floor);
+      const double w = sigma * sigma / length;
+      curve.emplace_back(i, i, w);
+      curve.emplace_back(j, j, w);
+      curve.emplace_back(i, j, -w);
+      curve.emplace_back(j, i, -w);
+      mass[i] += 0.5 * length;
+      mass[j] += 0.5 * length;
+    }
+  }
+  for (Eigen::Index i = 0; i < nb; ++i) curve.emplace_back(i, i, mass[i]);
+  Sparse loops(nb, nb);
+  loops.setFromTriplets(curve.begin(), curve.end());
+  return loops;
+}
+
+} // namespace
+
 LowPassFilter::LowPassFilter(const Mesh& mesh, const LowPassOptions& options)
     : n_(static_cast<Eigen::Index>(mesh.n_vertices())), steps_(options.steps) {
   check_options(options);
@@ -83,128 +212,35 @@ LowPassFilter::LowPassFilter(const Mesh& mesh, const LowPassOptions& options)
   // Isolated vertices (no face, zero mass) get an identity row.
   for (Eigen::Index i = 0; i < n_; ++i)
     if (!(mass[i] > 0.0)) mass[i] = 1.0;
-  // Edge weights times σ_i σ_j (σ² everywhere when nothing is capped: t W as before, bit for
-  // bit), the diagonal again minus the row's sum.
-  const double t = stats_.sigma * stats_.sigma;
+  // Nothing capped: σ² everywhere, exactly t W as without the cap.
   const bool uniform = stats_.capped == 0;
-  auto edge_t = [&](Eigen::Index i, Eigen::Index j) { return uniform ? t : field[i] * field[j]; };
-  if (!uniform) {
-    for (int k = 0; k < lap.weights.outerSize(); ++k) {
-      double sum = 0.0;
-      double* diagonal = nullptr;
-      for (Eigen::SparseMatrix<double>::InnerIterator it(lap.weights, k); it; ++it) {
-        if (it.row() == it.col()) {
-          diagonal = &it.valueRef();
-        } else {
-          it.valueRef() *= edge_t(it.row(), it.col());
-          sum += it.value();
-        }
-      }
-      if (diagonal) *diagonal = -sum;
-    }
-  }
-  const double scale = uniform ? t : 1.0; // what multiplies lap.weights from here on
+  if (!uniform) scale_by_field(lap.weights, field);
+  const double scale = uniform ? stats_.sigma * stats_.sigma : 1.0;
 
-  // Rows: interior vertices, then boundary ones (each index's place in its own block).
-  // Isolated vertices count as interior (OpenMesh calls them boundary).
-  std::vector<char> on_boundary(static_cast<std::size_t>(n_), 0);
-  std::vector<Eigen::Index> block(static_cast<std::size_t>(n_));
-  for (Eigen::Index i = 0; i < n_; ++i) {
-    const VertexHandle v(static_cast<int>(i));
-    on_boundary[static_cast<std::size_t>(i)] = !mesh.is_isolated(v) && mesh.is_boundary(v);
-    auto& list = on_boundary[static_cast<std::size_t>(i)] ? boundary_ : interior_;
-    block[static_cast<std::size_t>(i)] = static_cast<Eigen::Index>(list.size());
-    list.push_back(i);
-  }
-  const auto ni = static_cast<Eigen::Index>(interior_.size());
-  const auto nb = static_cast<Eigen::Index>(boundary_.size());
-  auto is_boundary = [&](Eigen::Index i) { return on_boundary[static_cast<std::size_t>(i)] != 0; };
-
-  // The interior system (M − tW)_II, and t W_IB for the boundary's values. A closed mesh has
-  // no boundary block: its matrix is built in place (igea_sub4: 0.25 s less than the triplets).
-  Eigen::SparseMatrix<double> a;
+  RowBlocks rows = row_blocks(mesh);
+  Sparse a;
   std::vector<Eigen::Triplet<double>> couple;
-  mass_.resize(ni);
-  if (nb == 0) {
-    mass_ = mass;
-    a = -scale * lap.weights;
-    for (Eigen::Index i = 0; i < ni; ++i) a.coeffRef(i, i) += mass_[i];
-    a.makeCompressed();
-  } else {
-    std::vector<Eigen::Triplet<double>> inner;
-    for (int k = 0; k < lap.weights.outerSize(); ++k)
-      for (Eigen::SparseMatrix<double>::InnerIterator it(lap.weights, k); it; ++it) {
-        const Eigen::Index r = it.row(), c = it.col();
-        if (is_boundary(r)) continue;
-        const auto br = block[static_cast<std::size_t>(r)], bc = block[static_cast<std::size_t>(c)];
-        if (is_boundary(c))
-          couple.emplace_back(br, bc, scale * it.value());
-        else
-          inner.emplace_back(br, bc, -scale * it.value());
-      }
-    for (Eigen::Index i = 0; i < ni; ++i) {
-      mass_[i] = mass[interior_[static_cast<std::size_t>(i)]];
-      inner.emplace_back(i, i, mass_[i]);
-    }
-    a.resize(ni, ni);
-    a.setFromTriplets(inner.begin(), inner.end());
-  }
+  interior_system(lap.weights, mass, scale, rows, a, mass_, couple);
   lap.weights.resize(0, 0);
   stats_.laplacian_stats = std::move(lap);
   SolverOptions solver_options;
   solver_options.name = "cg";
   solver_options.tolerance = options.tolerance;
-  if (ni > 0) {
+  if (!rows.interior.empty()) {
     solver_ = make_solver(solver_options);
     solver_->compute(a);
   }
-  coupling_.resize(ni, nb);
+  coupling_.resize(static_cast<Eigen::Index>(rows.interior.size()),
+                   static_cast<Eigen::Index>(rows.boundary.size()));
   coupling_.setFromTriplets(couple.begin(), couple.end());
-
-  // The loops' curve system: weights 1/length (floored, for coincident boundary vertices), mass
-  // half the adjacent lengths; each boundary vertex has exactly two boundary neighbours. A loop
-  // is a curve: what shrinks it is its own size, not the part's width, so its σ is capped by
-  // its radius (perimeter / 2π), one σ along the loop.
-  if (nb > 0) {
-    const double floor = 1e-9 * stats_.sigma;
-    std::vector<Eigen::Triplet<double>> curve;
-    boundary_mass_ = Eigen::VectorXd::Zero(nb);
-    std::vector<char> done(mesh.n_halfedges(), 0);
-    std::vector<HalfedgeHandle> loop;
-    for (auto start : mesh.halfedges()) {
-      if (!mesh.is_boundary(start) || done[static_cast<std::size_t>(start.idx())]) continue;
-      loop.clear();
-      double perimeter = 0.0;
-      for (HalfedgeHandle h = start; !done[static_cast<std::size_t>(h.idx())];
-           h = mesh.next_halfedge_handle(h)) {
-        done[static_cast<std::size_t>(h.idx())] = 1;
-        loop.push_back(h);
-        perimeter += mesh.calc_edge_length(h);
-      }
-      const double sigma =
-          options.feature_cap > 0.0
-              ? std::min(stats_.sigma, options.feature_cap * perimeter / (2.0 * std::numbers::pi))
-              : stats_.sigma;
-      stats_.capped_loops += sigma < stats_.sigma ? 1 : 0;
-      for (const HalfedgeHandle h : loop) {
-        const auto i = block[static_cast<std::size_t>(mesh.from_vertex_handle(h).idx())];
-        const auto j = block[static_cast<std::size_t>(mesh.to_vertex_handle(h).idx())];
-        const double length = std::max(mesh.calc_edge_length(h), floor);
-        const double w = sigma * sigma / length;
-        curve.emplace_back(i, i, w);
-        curve.emplace_back(j, j, w);
-        curve.emplace_back(i, j, -w);
-        curve.emplace_back(j, i, -w);
-        boundary_mass_[i] += 0.5 * length;
-        boundary_mass_[j] += 0.5 * length;
-      }
-    }
-    for (Eigen::Index i = 0; i < nb; ++i) curve.emplace_back(i, i, boundary_mass_[i]);
-    Eigen::SparseMatrix<double> loops(nb, nb);
-    loops.setFromTriplets(curve.begin(), curve.end());
+  if (!rows.boundary.empty()) {
+    const Sparse loops = loop_system(mesh, rows, stats_.sigma, options.feature_cap, boundary_mass_,
+                                     stats_.capped_loops);
     boundary_solver_ = make_solver(solver_options);
     boundary_solver_->compute(loops);
   }
+  interior_ = std::move(rows.interior);
+  boundary_ = std::move(rows.boundary);
   solved_ = true;
 }
 

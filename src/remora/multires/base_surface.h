@@ -7,10 +7,10 @@
 //
 // Boundaries: a boundary loop is filtered as a curve, by the same step with the curve's own
 // operator (edge weights 1/length, mass half the adjacent boundary lengths), and the interior then
-// takes the filtered loops as Dirichlet values. With the surface operator's natural condition
-// instead, the cotan Laplacian pulls every boundary vertex inward in the tangent plane: by 2 mean
-// edge lengths on heightfield/AcrossRiver.stl at σ = 2, where the first rows of triangles folded
-// (docs/editing.md). A straight, evenly sampled boundary of a plane now stays where it is.
+// takes the filtered loops as Dirichlet values, so a straight, evenly sampled boundary of a plane
+// stays where it is. The surface operator's natural condition instead would pull every boundary
+// vertex inward in the tangent plane, by about σ, and fold the first rows of triangles
+// (docs/editing.md).
 //
 // Strength: t = σ², σ = smoothing × the mesh's length scale (its mean edge length unless needles
 // inflate it: geometry/measures.h, length_scale()). A Laplacian eigenfunction of

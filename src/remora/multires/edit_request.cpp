@@ -19,15 +19,18 @@ using nlohmann::json;
   throw InvalidArgument(fmt::format("{}: {}", path, problem));
 }
 
+/// "a, b, c".
+std::string listed(std::initializer_list<const char*> items) {
+  std::string list;
+  for (const char* item : items) list += std::string(list.empty() ? "" : ", ") + item;
+  return list;
+}
+
 void only_keys(const json& j, const std::string& path, std::initializer_list<const char*> keys) {
   if (!j.is_object()) fail(path, "expected an object");
-  for (const auto& item : j.items()) {
-    if (std::none_of(keys.begin(), keys.end(), [&](const char* k) { return item.key() == k; })) {
-      std::string allowed;
-      for (const char* k : keys) allowed += std::string(allowed.empty() ? "" : ", ") + k;
-      fail(path, fmt::format("unknown key '{}' (allowed: {})", item.key(), allowed));
-    }
-  }
+  for (const auto& item : j.items())
+    if (std::none_of(keys.begin(), keys.end(), [&](const char* k) { return item.key() == k; }))
+      fail(path, fmt::format("unknown key '{}' (allowed: {})", item.key(), listed(keys)));
 }
 
 double number(const json& j, const std::string& path) {
@@ -54,6 +57,13 @@ const json& member(const json& j, const std::string& path, const char* key) {
   return j.at(key);
 }
 
+/// The "radius" of a sphere or geodesic region at `path`: a number >= 0.
+double radius(const json& j, const std::string& path) {
+  const double r = number(member(j, path, "radius"), path + ".radius");
+  if (r < 0) fail(path + ".radius", "must be >= 0");
+  return r;
+}
+
 std::vector<int> id_list(const json& j, const std::string& path) {
   if (!j.is_array()) fail(path, "expected an array of vertex ids");
   std::vector<int> ids;
@@ -68,11 +78,8 @@ std::string name(const json& j, const std::string& path,
   if (!j.is_string()) fail(path, "expected a string");
   const auto s = j.get<std::string>();
   if (allowed.size() > 0 &&
-      std::none_of(allowed.begin(), allowed.end(), [&](const char* a) { return s == a; })) {
-    std::string list;
-    for (const char* a : allowed) list += std::string(list.empty() ? "" : ", ") + a;
-    fail(path, fmt::format("unknown value '{}' (allowed: {})", s, list));
-  }
+      std::none_of(allowed.begin(), allowed.end(), [&](const char* a) { return s == a; }))
+    fail(path, fmt::format("unknown value '{}' (allowed: {})", s, listed(allowed)));
   return s;
 }
 
@@ -98,8 +105,7 @@ RegionSpec parse_region(const json& j, const std::string& path) {
     only_keys(value, sub, {"center", "radius"});
     r.kind = RegionSpec::Kind::Sphere;
     r.center = vec3(member(value, sub, "center"), sub + ".center");
-    r.radius = number(member(value, sub, "radius"), sub + ".radius");
-    if (r.radius < 0) fail(sub + ".radius", "must be >= 0");
+    r.radius = radius(value, sub);
   } else if (key == "box") {
     only_keys(value, sub, {"min", "max"});
     r.kind = RegionSpec::Kind::Box;
@@ -111,8 +117,7 @@ RegionSpec parse_region(const json& j, const std::string& path) {
     only_keys(value, sub, {"vertex", "radius"});
     r.kind = RegionSpec::Kind::Geodesic;
     r.vertex = vertex_id(member(value, sub, "vertex"), sub + ".vertex");
-    r.radius = number(member(value, sub, "radius"), sub + ".radius");
-    if (r.radius < 0) fail(sub + ".radius", "must be >= 0");
+    r.radius = radius(value, sub);
   } else {
     r.kind = RegionSpec::Kind::Union;
     if (!value.is_array() || value.empty()) fail(sub, "expected a non-empty array of regions");

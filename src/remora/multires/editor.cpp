@@ -1,7 +1,6 @@
 #include "remora/multires/editor.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <optional>
 #include <utility>
@@ -12,6 +11,7 @@
 
 #include "remora/common/error.h"
 #include "remora/common/parallel.h"
+#include "remora/common/timer.h"
 #include "remora/geometry/laplacian.h"
 #include "remora/geometry/measures.h"
 #include "remora/multires/multigrid.h"
@@ -19,57 +19,11 @@
 namespace remora {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double ms_since(Clock::time_point t0) {
-  return std::chrono::duration<double, std::milli>(Clock::now() - t0).count();
-}
-
 int largest(const std::array<double, 3>& a) {
   return a[0] >= a[1] && a[0] >= a[2] ? 0 : (a[1] >= a[2] ? 1 : 2);
 }
 
 } // namespace
-
-// ---- transforms ------------------------------------------------------------------------------
-
-Transform identity_transform() {
-  Transform t = Transform::Zero();
-  t.leftCols<3>().setIdentity();
-  return t;
-}
-
-Transform translation(const Eigen::Vector3d& offset) {
-  Transform t = identity_transform();
-  t.col(3) = offset;
-  return t;
-}
-
-Transform rotation(const Eigen::Vector3d& axis, double radians, const Eigen::Vector3d& center) {
-  if (!axis.allFinite() || !(axis.norm() > 0.0) || !std::isfinite(radians) || !center.allFinite())
-    throw InvalidArgument("rotation: the axis must be finite and non-zero, the angle and the "
-                          "center finite");
-  Transform t;
-  const Eigen::Matrix3d r = Eigen::AngleAxisd(radians, axis.normalized()).toRotationMatrix();
-  t.leftCols<3>() = r;
-  t.col(3) = center - r * center;
-  return t;
-}
-
-Transform scaling(const Eigen::Vector3d& factors, const Eigen::Vector3d& center) {
-  if (!factors.allFinite() || !center.allFinite())
-    throw InvalidArgument("scaling: the factors and the center must be finite");
-  Transform t = Transform::Zero();
-  t.leftCols<3>() = factors.asDiagonal();
-  t.col(3) = center - factors.cwiseProduct(center);
-  return t;
-}
-
-Transform compose(const Transform& a, const Transform& b) {
-  Transform t;
-  t.leftCols<3>() = a.leftCols<3>() * b.leftCols<3>();
-  t.col(3) = a.leftCols<3>() * b.col(3) + a.col(3);
-  return t;
-}
 
 std::string to_string(DetailMode mode) {
   switch (mode) {
@@ -143,6 +97,18 @@ struct Editor::Impl {
     return *region;
   }
   void update();
+
+  // The steps of set_region(), in order, on a new state (the current region stays until all
+  // succeed).
+  std::unique_ptr<RegionState> paint(const std::vector<int>& support,
+                                     const std::vector<std::vector<int>>& handles) const;
+  void map_to_base(RegionState& r) const;
+  void report_region(const RegionState& r);
+  Eigen::MatrixXd constrained_values(const RegionState& r, const std::vector<int>& vertices,
+                                     bool by_vertex) const;
+  void solve_basis(RegionState& r);
+  void encode_details(RegionState& r);
+  void find_affected(RegionState& r) const;
 };
 
 namespace {
@@ -256,11 +222,11 @@ Editor::Editor(Editor&&) noexcept = default;
 Editor& Editor::operator=(Editor&&) noexcept = default;
 Editor::~Editor() = default;
 
-void Editor::set_region(const std::vector<int>& support,
-                        const std::vector<std::vector<int>>& handles) {
-  Impl& m = *impl_;
-  const auto t_start = Clock::now();
-  const auto n = static_cast<int>(m.input.n_vertices());
+// Validates the painted ids and labels the input vertices; the handles' centroids.
+std::unique_ptr<RegionState>
+Editor::Impl::paint(const std::vector<int>& support,
+                    const std::vector<std::vector<int>>& handles) const {
+  const auto n = static_cast<int>(input.n_vertices());
   if (support.empty()) throw InvalidArgument("the support is empty: paint at least one vertex");
   if (handles.empty())
     throw InvalidArgument("no handle: paint at least one handle inside the support");
@@ -293,29 +259,32 @@ void Editor::set_region(const std::vector<int>& support,
         throw InvalidArgument(fmt::format(
             "vertex {} is in handle {} and in handle {}; handles must not overlap", v, label, j));
       label = j;
-      center += m.input_positions.row(v).transpose();
+      center += input_positions.row(v).transpose();
     }
     r.handle_centers.push_back(center / double(h.size()));
   }
+  return state;
+}
 
-  // Map the region onto the base: a base vertex takes the label of the input vertex nearest to
-  // its location (largest barycentric weight); then every painted input vertex claims the base
-  // vertex nearest to its own location, so that small handles and supports are not lost.
-  const auto nb = static_cast<std::size_t>(m.base.n_vertices());
+// Maps the region onto the base: a base vertex takes the label of the input vertex nearest to
+// its location (largest barycentric weight); then every painted input vertex claims the base
+// vertex nearest to its own location, so that small handles and supports are not lost.
+void Editor::Impl::map_to_base(RegionState& r) const {
+  const auto nb = static_cast<std::size_t>(base.n_vertices());
   r.base_label.assign(nb, Region::kFixed);
-  if (m.options.remesh) {
+  if (options.remesh) {
     for (std::size_t v = 0; v < nb; ++v) {
-      const SurfacePoint& sp = m.base_on_input[v];
-      const int corner = m.input_topology.faces[static_cast<std::size_t>(sp.face.idx())]
-                                               [static_cast<std::size_t>(largest(sp.bary))];
+      const SurfacePoint& sp = base_on_input[v];
+      const int corner = input_topology.faces[static_cast<std::size_t>(sp.face.idx())]
+                                             [static_cast<std::size_t>(largest(sp.bary))];
       r.base_label[v] = r.input_label[static_cast<std::size_t>(corner)];
     }
-    for (int i = 0; i < n; ++i) {
-      const int label = r.input_label[static_cast<std::size_t>(i)];
-      const SurfacePoint& sp = m.input_on_base[static_cast<std::size_t>(i)];
+    for (std::size_t i = 0; i < r.input_label.size(); ++i) {
+      const int label = r.input_label[i];
+      const SurfacePoint& sp = input_on_base[i];
       if (label == Region::kFixed || !sp.face.is_valid()) continue;
-      const int w = m.topology.faces[static_cast<std::size_t>(sp.face.idx())]
-                                    [static_cast<std::size_t>(largest(sp.bary))];
+      const int w = topology.faces[static_cast<std::size_t>(sp.face.idx())]
+                                  [static_cast<std::size_t>(largest(sp.bary))];
       int& bl = r.base_label[static_cast<std::size_t>(w)];
       if (label >= 0 ? bl < 0 : bl == Region::kFixed) bl = label;
     }
@@ -326,158 +295,179 @@ void Editor::set_region(const std::vector<int>& support,
   for (std::size_t v = 0; v < nb; ++v)
     if (r.base_label[v] >= 0)
       r.handle_base[static_cast<std::size_t>(r.base_label[v])].push_back(static_cast<int>(v));
-  m.report.support_vertices = 0;
-  m.report.handle_vertices.assign(static_cast<std::size_t>(r.handles), 0);
-  for (const int label : r.input_label) {
-    if (label != Region::kFixed) ++m.report.support_vertices;
-    if (label >= 0) ++m.report.handle_vertices[static_cast<std::size_t>(label)];
-  }
+}
 
-  // The region's figures, before the solve, so that a failing solve still reports them.
+// The region's figures, before the solve, so that a failing solve still reports them.
+void Editor::Impl::report_region(const RegionState& r) {
+  report.support_vertices = 0;
+  report.handle_vertices.assign(static_cast<std::size_t>(r.handles), 0);
+  for (const int label : r.input_label) {
+    if (label != Region::kFixed) ++report.support_vertices;
+    if (label >= 0) ++report.handle_vertices[static_cast<std::size_t>(label)];
+  }
   std::size_t free_count = 0, constrained = 0;
   for (const int label : r.base_label) (label == Region::kFree ? free_count : constrained)++;
-  m.report.free_base_vertices = free_count;
-  m.report.constrained_base_vertices = constrained;
-  m.report.handle_base_vertices.clear();
-  for (const auto& h : r.handle_base) m.report.handle_base_vertices.push_back(h.size());
-  m.report.negative_weights_in_support = 0;
-  for (const auto& [a, b] : m.negative_edges)
+  report.free_base_vertices = free_count;
+  report.constrained_base_vertices = constrained;
+  report.handle_base_vertices.clear();
+  for (const auto& h : r.handle_base) report.handle_base_vertices.push_back(h.size());
+  report.negative_weights_in_support = 0;
+  for (const auto& [a, b] : negative_edges)
     if (r.base_label[static_cast<std::size_t>(a)] == Region::kFree ||
         r.base_label[static_cast<std::size_t>(b)] == Region::kFree)
-      ++m.report.negative_weights_in_support;
+      ++report.negative_weights_in_support;
+}
 
-  // The system on the base, factored once; the 3 + 4h basis functions.
-  const Region region{r.base_label};
+// The constrained values of the 3 + 4h basis functions, one column each: the fixed vertices'
+// x, y, z, and per handle its vertices' x, y, z and 1. A row per vertex of `vertices`, or with
+// `by_vertex` a row per base vertex (the others zero).
+Eigen::MatrixXd Editor::Impl::constrained_values(const RegionState& r,
+                                                 const std::vector<int>& vertices,
+                                                 bool by_vertex) const {
+  const int columns = 3 + 4 * r.handles;
+  Eigen::MatrixXd out =
+      Eigen::MatrixXd::Zero(by_vertex ? static_cast<Eigen::Index>(base.n_vertices())
+                                      : static_cast<Eigen::Index>(vertices.size()),
+                            columns);
+  for (std::size_t c = 0; c < vertices.size(); ++c) {
+    const int v = vertices[c];
+    const int label = r.base_label[static_cast<std::size_t>(v)];
+    const Eigen::Index row = by_vertex ? v : static_cast<Eigen::Index>(c);
+    const Eigen::RowVector3d p = base_rest.row(v);
+    if (label == Region::kFixed) {
+      out.block<1, 3>(row, 0) = p;
+    } else if (label >= 0) {
+      out.block<1, 3>(row, 3 + 4 * label) = p;
+      out(row, 3 + 4 * label + 3) = 1.0;
+    }
+  }
+  return out;
+}
+
+// The system on the base, factored once; the 3 + 4h basis functions.
+void Editor::Impl::solve_basis(RegionState& r) {
+  const Region labels{r.base_label};
   const std::string on_base =
-      m.options.remesh
-          ? fmt::format("on the remeshed base (edge length {:.4g}): ", m.report.base_target_length)
+      options.remesh
+          ? fmt::format("on the remeshed base (edge length {:.4g}): ", report.base_target_length)
           : std::string("on the mesh itself: ");
   auto t0 = Clock::now();
-  const int columns = 3 + 4 * r.handles;
-  const std::string name = m.solver_name(m.options.system.areas != AreaWeights::Mixed);
-  std::unique_ptr<Solver> solver;
-  KHarmonicSystem system;
-  Eigen::MatrixXd values; // constrained values, one column per basis function
-  auto fill_values = [&](const std::vector<int>& vertices, Eigen::MatrixXd& out, bool by_vertex) {
-    out = Eigen::MatrixXd::Zero(by_vertex ? static_cast<Eigen::Index>(nb)
-                                          : static_cast<Eigen::Index>(vertices.size()),
-                                columns);
-    for (std::size_t c = 0; c < vertices.size(); ++c) {
-      const int v = vertices[c];
-      const int label = r.base_label[static_cast<std::size_t>(v)];
-      const Eigen::Index row = by_vertex ? v : static_cast<Eigen::Index>(c);
-      const Eigen::RowVector3d p = m.base_rest.row(v);
-      if (label == Region::kFixed) {
-        out.block<1, 3>(row, 0) = p;
-      } else if (label >= 0) {
-        out.block<1, 3>(row, 3 + 4 * label) = p;
-        out(row, 3 + 4 * label + 3) = 1.0;
-      }
-    }
-  };
+  const std::string name = solver_name(options.system.areas != AreaWeights::Mixed);
   try {
     if (name == "multigrid") {
-      if (!m.multigrid) {
+      if (!multigrid) {
         MultigridOptions mo;
-        mo.k = m.options.system.k;
-        mo.areas = m.options.system.areas;
-        mo.tolerance = m.options.solver.tolerance;
-        mo.threads = m.options.threads;
-        m.multigrid = std::make_unique<MultigridSolver>(m.base, mo);
+        mo.k = options.system.k;
+        mo.areas = options.system.areas;
+        mo.tolerance = options.solver.tolerance;
+        mo.threads = options.threads;
+        multigrid = std::make_unique<MultigridSolver>(base, mo);
       }
-      m.multigrid->set_region(region);
-      m.report.milliseconds["assemble"] = 0.0;
-      m.report.milliseconds["factor"] = ms_since(t0);
+      multigrid->set_region(labels);
+      report.milliseconds["assemble"] = 0.0;
+      report.milliseconds["factor"] = ms_since(t0);
       t0 = Clock::now();
-      std::vector<int> all(nb);
-      for (std::size_t v = 0; v < nb; ++v) all[v] = static_cast<int>(v);
-      fill_values(all, values, true);
-      r.basis = m.multigrid->solve(values);
-      r.free_vertices = m.multigrid->fine_system().free_vertices;
+      std::vector<int> all(base.n_vertices());
+      for (std::size_t v = 0; v < all.size(); ++v) all[v] = static_cast<int>(v);
+      r.basis = multigrid->solve(constrained_values(r, all, true));
+      r.free_vertices = multigrid->fine_system().free_vertices;
       int iterations = 0;
-      for (const auto& level : m.multigrid->stats())
+      for (const auto& level : multigrid->stats())
         iterations = std::max(iterations, level.iterations);
-      m.report.solver_stats = SolverStats{};
-      m.report.solver_stats.iterations = iterations;
+      report.solver_stats = SolverStats{};
+      report.solver_stats.iterations = iterations;
     } else {
-      system = assemble_kharmonic(m.base, region, m.options.system);
-      m.report.milliseconds["assemble"] = ms_since(t0);
+      const KHarmonicSystem system = assemble_kharmonic(base, labels, options.system);
+      report.milliseconds["assemble"] = ms_since(t0);
       t0 = Clock::now();
-      SolverOptions so = m.options.solver;
+      SolverOptions so = options.solver;
       so.name = name;
-      solver = make_solver(so);
+      const std::unique_ptr<Solver> solver = make_solver(so);
       solver->compute(system.matrix);
-      m.report.milliseconds["factor"] = ms_since(t0);
+      report.milliseconds["factor"] = ms_since(t0);
       t0 = Clock::now();
-      fill_values(system.constrained_vertices, values, false);
-      r.basis = solver->solve(system.rhs(values));
+      r.basis =
+          solver->solve(system.rhs(constrained_values(r, system.constrained_vertices, false)));
       r.free_vertices = system.free_vertices;
-      m.report.solver_stats = solver->stats();
+      report.solver_stats = solver->stats();
     }
   } catch (const InvalidArgument& e) {
     throw InvalidArgument(on_base + e.what());
   } catch (const NumericalError& e) {
     throw NumericalError(on_base + e.what());
   }
-  m.report.milliseconds["solve"] = ms_since(t0);
-  m.report.solver = name;
-  m.report.solves = columns;
+  report.milliseconds["solve"] = ms_since(t0);
+  report.solver = name;
+  report.solves = 3 + 4 * r.handles;
   if (!r.basis.allFinite())
     throw NumericalError(on_base + "the solver returned non-finite values; try a direct solver");
+}
 
-  // B0: the fill-in with the handles undeformed.
-  t0 = Clock::now();
-  r.rest = m.base_rest;
+// B0 (the fill-in with the handles undeformed), its normals, and the Phong details of the painted
+// input vertices against it.
+void Editor::Impl::encode_details(RegionState& r) {
+  const auto t0 = Clock::now();
+  r.rest = base_rest;
   for (std::size_t row = 0; row < r.free_vertices.size(); ++row) {
     Eigen::RowVector3d p = r.basis.block<1, 3>(static_cast<Eigen::Index>(row), 0);
     for (int j = 0; j < r.handles; ++j)
       p += r.basis.block<1, 3>(static_cast<Eigen::Index>(row), 3 + 4 * j);
     r.rest.row(r.free_vertices[row]) = p;
   }
-  r.rest_normals = vertex_normals(m.topology, r.rest);
-
-  // Phong details of the painted input vertices against B0.
+  r.rest_normals = vertex_normals(topology, r.rest);
   std::vector<int> starts;
-  for (int i = 0; i < n; ++i) {
-    const SurfacePoint& sp = m.input_on_base[static_cast<std::size_t>(i)];
-    if (r.input_label[static_cast<std::size_t>(i)] == Region::kFixed || !sp.face.is_valid())
-      continue;
-    r.encoded.push_back(i);
+  for (std::size_t i = 0; i < r.input_label.size(); ++i) {
+    const SurfacePoint& sp = input_on_base[i];
+    if (r.input_label[i] == Region::kFixed || !sp.face.is_valid()) continue;
+    r.encoded.push_back(static_cast<int>(i));
     starts.push_back(sp.face.idx());
   }
   Eigen::MatrixXd points(static_cast<Eigen::Index>(r.encoded.size()), 3);
   for (std::size_t e = 0; e < r.encoded.size(); ++e)
-    points.row(static_cast<Eigen::Index>(e)) = m.input_positions.row(r.encoded[e]);
-  r.details = encode_phong(m.topology, r.rest, r.rest_normals, points, starts, m.options.phong,
-                           &m.report.phong, m.options.threads);
-  if (m.options.details == DetailMode::Displacement) {
+    points.row(static_cast<Eigen::Index>(e)) = input_positions.row(r.encoded[e]);
+  r.details = encode_phong(topology, r.rest, r.rest_normals, points, starts, options.phong,
+                           &report.phong, options.threads);
+  if (options.details == DetailMode::Displacement) {
     r.rest_offsets.resize(r.details.size());
     for (std::size_t e = 0; e < r.details.size(); ++e) {
       PhongDetail foot = r.details[e];
       foot.offset = 0.0;
       foot.residual = false;
       r.rest_offsets[e] = points.row(static_cast<Eigen::Index>(e)).transpose() -
-                          decode_phong(m.topology, r.rest, r.rest_normals, foot);
+                          decode_phong(topology, r.rest, r.rest_normals, foot);
     }
   }
-  m.report.milliseconds["encode"] = ms_since(t0);
+  report.milliseconds["encode"] = ms_since(t0);
+}
 
-  // The base vertices whose normals can change: every corner of a face with a moving vertex.
-  std::vector<char> affected(nb, 0);
-  for (const auto& f : m.topology.faces)
+// The base vertices whose normals can change: every corner of a face with a moving vertex.
+void Editor::Impl::find_affected(RegionState& r) const {
+  std::vector<char> affected(base.n_vertices(), 0);
+  for (const auto& f : topology.faces)
     if (r.base_label[static_cast<std::size_t>(f[0])] != Region::kFixed ||
         r.base_label[static_cast<std::size_t>(f[1])] != Region::kFixed ||
         r.base_label[static_cast<std::size_t>(f[2])] != Region::kFixed)
       for (const int v : f) affected[static_cast<std::size_t>(v)] = 1;
-  for (std::size_t v = 0; v < nb; ++v)
+  for (std::size_t v = 0; v < affected.size(); ++v)
     if (affected[v]) r.affected.push_back(static_cast<int>(v));
+}
 
+void Editor::set_region(const std::vector<int>& support,
+                        const std::vector<std::vector<int>>& handles) {
+  Impl& m = *impl_;
+  const auto t_start = Clock::now();
+  std::unique_ptr<RegionState> state = m.paint(support, handles);
+  RegionState& r = *state;
+  m.map_to_base(r);
+  m.report_region(r);
+  m.solve_basis(r);
+  m.encode_details(r);
+  m.find_affected(r);
   r.transforms.assign(static_cast<std::size_t>(r.handles), identity_transform());
   r.current_base = r.rest;
   r.current_normals = r.rest_normals;
   r.current_positions = m.input_positions;
   r.dirty = true;
-
   m.region = std::move(state);
   m.report.milliseconds["set_region"] = ms_since(t_start);
 }
