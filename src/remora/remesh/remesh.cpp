@@ -126,7 +126,7 @@ RemeshResult run(const Mesh& input, const RemeshOptions& options) {
     reproject_points(rm); // the repair changed faces after the last moves
     result.input_on_output = closest_input_locations(rm, report);
   });
-  result.mesh = rm.take_mesh();
+  rm.take_mesh(result.mesh);
   report.milliseconds["total"] = ms_since(t_total);
   return result;
 }

@@ -38,7 +38,7 @@ void Remesher::add_properties() {
   mesh.add_property(points_);
 }
 
-void Remesher::adopt_renumbered(Mesh renumbered, const MeshOrder& order) {
+void Remesher::adopt_renumbered(Mesh&& renumbered, const MeshOrder& order) {
   OpenMesh::VPropHandleT<VertexState> vertex_state;
   OpenMesh::EPropHandleT<char> feature;
   OpenMesh::FPropHandleT<PointList> points;
@@ -60,11 +60,11 @@ void Remesher::adopt_renumbered(Mesh renumbered, const MeshOrder& order) {
   points_ = points;
 }
 
-Mesh Remesher::take_mesh() {
+void Remesher::take_mesh(Mesh& out) {
   mesh.remove_property(vertex_state_);
   mesh.remove_property(feature_);
   mesh.remove_property(points_);
-  return std::move(mesh);
+  out = std::move(mesh);
 }
 
 } // namespace remora::remesh_detail

@@ -67,9 +67,12 @@ public:
 
   /// Replaces the working mesh by `renumbered`, a copy made by copy_in_order() (order.cpp), and
   /// carries every element's state along `order` (new index -> old index).
-  void adopt_renumbered(Mesh renumbered, const struct MeshOrder& order);
-  /// The working mesh without the working properties; the Remesher is spent afterwards.
-  Mesh take_mesh();
+  void adopt_renumbered(Mesh&& renumbered, const struct MeshOrder& order);
+  /// Hands the working mesh, without the working properties, to `out`; the Remesher is spent.
+  /// OpenMesh's meshes have no move: every assignment copies, so there is one here and one in
+  /// adopt_renumbered, and none elsewhere. The passes' buffers are their own locals: kept here
+  /// between calls, they raised the peak resident memory of a million-triangle remesh.
+  void take_mesh(Mesh& out);
 
   const Mesh& input;
   const RemeshOptions& options;
