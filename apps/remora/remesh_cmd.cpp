@@ -16,6 +16,21 @@ namespace remora::cli {
 
 namespace {
 
+// A number in (lo, hi] (`open_low`) or in [lo, hi): CLI::Range includes both ends, and the
+// library refuses the excluded one.
+CLI::Validator half_open_range(double lo, double hi, bool open_low) {
+  const std::string interval =
+      open_low ? fmt::format("({}, {}]", lo, hi) : fmt::format("[{}, {})", lo, hi);
+  return CLI::Validator(
+      [=](std::string& text) -> std::string {
+        double x = 0;
+        if (!CLI::detail::lexical_cast(text, x)) return "not a number: " + text;
+        const bool inside = open_low ? x > lo && x <= hi : x >= lo && x < hi;
+        return inside ? std::string() : fmt::format("{} is not in {}", text, interval);
+      },
+      "FLOAT in " + interval);
+}
+
 void print_remesh_report(std::ostream& os, const RemeshReport& r) {
   os << fmt::format("target edge length l = {:.6g}{}\n", r.target_length,
                     r.length_from_area ? " (from the area per vertex: needles inflate the mean "
@@ -147,7 +162,7 @@ void add_equalization_options(CLI::App* cmd, RemeshArgs& a) {
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   cmd->add_option("--lambda", o.lambda, "Damping of the area-equalizing update, in (0, 1]")
-      ->check(CLI::Range(0.0, 1.0))
+      ->check(half_open_range(0.0, 1.0, true))
       ->capture_default_str();
   cmd->add_option("--method", a.method,
                   "Area equalization: newton (default) or gravity (the paper's update)")
@@ -170,7 +185,7 @@ void add_equalization_options(CLI::App* cmd, RemeshArgs& a) {
   cmd->add_option("--guard-angle", o.equalize_guard_deg,
                   "newton: shorten fine-tuning moves that would bring a face below this angle "
                   "(degrees; 0 = off)")
-      ->check(CLI::Range(0.0, 60.0))
+      ->check(half_open_range(0.0, 60.0, false))
       ->capture_default_str();
   cmd->add_flag("!--no-boundary-equalization", o.equalize_boundary,
                 "newton: leave the boundary vertices' areas out of the fine-tuning (next to the "
