@@ -28,6 +28,80 @@ float up(double x) {
   return static_cast<double>(f) < x ? std::nextafter(f, std::numeric_limits<float>::infinity()) : f;
 }
 
+// Throws InvalidArgument unless origin and direction are finite, direction is not zero and
+// t_min <= t_max.
+void check_ray(const Vec3& origin, const Vec3& direction, double t_min, double t_max) {
+  for (int k = 0; k < 3; ++k)
+    if (!std::isfinite(origin[k]) || !std::isfinite(direction[k]))
+      throw InvalidArgument("ray caster: the ray's origin and direction must be finite");
+  if (!(direction.sqrnorm() > 0.0))
+    throw InvalidArgument("ray caster: the ray's direction is zero");
+  if (!(t_min <= t_max))
+    throw InvalidArgument(
+        fmt::format("ray caster: t_min {} must not exceed t_max {}", t_min, t_max));
+}
+
+// origin + t direction, with the reciprocal of the direction (+-inf on an axis-parallel ray).
+struct Ray {
+  Ray(const Vec3& o, const Vec3& d) : origin(o), direction(d) {
+    for (int k = 0; k < 3; ++k) inv[k] = 1.0 / direction[k];
+  }
+
+  /// Does the ray meet the box [lo, hi] within (t_min, t_max]?
+  bool meets(const float lo[3], const float hi[3], double t_min, double t_max) const {
+    double enter = t_min, leave = t_max;
+    for (int k = 0; k < 3; ++k) {
+      if (direction[k] == 0.0) {
+        if (origin[k] < lo[k] || origin[k] > hi[k]) return false;
+        continue;
+      }
+      double t0 = (lo[k] - origin[k]) * inv[k], t1 = (hi[k] - origin[k]) * inv[k];
+      if (t0 > t1) std::swap(t0, t1);
+      enter = std::max(enter, t0);
+      leave = std::min(leave, t1);
+      if (enter > leave) return false;
+    }
+    return true;
+  }
+
+  const Vec3& origin;
+  const Vec3& direction;
+  double inv[3];
+};
+
+// The axis along which the direction has its largest magnitude (the first of equal ones).
+int dominant_axis(const Vec3& direction) {
+  int axis = 0;
+  for (int k = 1; k < 3; ++k)
+    if (std::abs(direction[k]) > std::abs(direction[axis])) axis = k;
+  return axis;
+}
+
+// Where a ray meets a triangle: origin + t direction = (1 - u - v) a + u b + v c.
+struct TriangleHit {
+  double t, u, v;
+};
+
+// Möller–Trumbore: false when the ray is parallel to the plane of (a, b, c) or misses the
+// triangle by more than a relative 1e-12 on the barycentrics; any t is returned.
+bool meet_triangle(const Ray& ray, const Vec3& a, const Vec3& b, const Vec3& c, TriangleHit& out) {
+  constexpr double kTolerance = 1e-12;
+  const Vec3 ab = b - a;
+  const Vec3 ac = c - a;
+  const Vec3 p = OpenMesh::cross(ray.direction, ac);
+  const double det = OpenMesh::dot(ab, p);
+  if (det == 0.0) return false;
+  const double inv_det = 1.0 / det;
+  const Vec3 s = ray.origin - a;
+  const double u = OpenMesh::dot(s, p) * inv_det;
+  if (u < -kTolerance || u > 1.0 + kTolerance) return false;
+  const Vec3 q = OpenMesh::cross(s, ab);
+  const double v = OpenMesh::dot(ray.direction, q) * inv_det;
+  if (v < -kTolerance || u + v > 1.0 + kTolerance) return false;
+  out = {OpenMesh::dot(ac, q) * inv_det, u, v};
+  return true;
+}
+
 } // namespace
 
 RayCaster::RayCaster(const Mesh& mesh) {
@@ -148,53 +222,25 @@ void RayCaster::build(std::vector<Node>& nodes, std::vector<std::int32_t>& order
 
 RayHit RayCaster::first_hit(const Vec3& origin, const Vec3& direction, double t_min, double t_max,
                             VertexHandle skip) const {
-  for (int k = 0; k < 3; ++k)
-    if (!std::isfinite(origin[k]) || !std::isfinite(direction[k]))
-      throw InvalidArgument("ray caster: the ray's origin and direction must be finite");
-  if (!(direction.sqrnorm() > 0.0))
-    throw InvalidArgument("ray caster: the ray's direction is zero");
-  if (!(t_min <= t_max))
-    throw InvalidArgument(
-        fmt::format("ray caster: t_min {} must not exceed t_max {}", t_min, t_max));
+  check_ray(origin, direction, t_min, t_max);
   RayHit hit;
   if (nodes_.empty()) return hit;
-  double inv[3];
-  for (int k = 0; k < 3; ++k) inv[k] = 1.0 / direction[k]; // +-inf on an axis-parallel ray
+  const Ray ray(origin, direction);
+  const int axis = dominant_axis(direction);
   const int skipped = skip.is_valid() ? skip.idx() : -1;
   double best = t_max;
-  constexpr double kTolerance = 1e-12;
-
-  // Does the ray meet the node's box within (t_min, best]?
-  auto meets = [&](const Node& n) {
-    double enter = t_min, leave = best;
-    for (int k = 0; k < 3; ++k) {
-      if (direction[k] == 0.0) {
-        if (origin[k] < n.lo[k] || origin[k] > n.hi[k]) return false;
-        continue;
-      }
-      double t0 = (n.lo[k] - origin[k]) * inv[k], t1 = (n.hi[k] - origin[k]) * inv[k];
-      if (t0 > t1) std::swap(t0, t1);
-      enter = std::max(enter, t0);
-      leave = std::min(leave, t1);
-      if (enter > leave) return false;
-    }
-    return true;
-  };
 
   std::int32_t stack[kMaxDepth];
   int top = 0;
   stack[top++] = 0;
   while (top > 0) {
     const Node& n = nodes_[static_cast<std::size_t>(stack[--top])];
-    if (!meets(n)) continue;
+    if (!ray.meets(n.lo, n.hi, t_min, best)) continue;
     if (n.count == 0) {
       // Visit the child nearer along the ray first (pushed last).
       const auto left = static_cast<std::int32_t>(&n - nodes_.data()) + 1, right = n.first;
       const Node& l = nodes_[static_cast<std::size_t>(left)];
       const Node& r = nodes_[static_cast<std::size_t>(right)];
-      int axis = 0;
-      for (int k = 1; k < 3; ++k)
-        if (std::abs(direction[k]) > std::abs(direction[axis])) axis = k;
       const bool left_first =
           (direction[axis] >= 0) == (l.lo[axis] + l.hi[axis] <= r.lo[axis] + r.hi[axis]);
       assert(top + 2 <= kMaxDepth); // each level holds at most one pending sibling
@@ -205,26 +251,16 @@ RayHit RayCaster::first_hit(const Vec3& origin, const Vec3& direction, double t_
     for (std::int32_t i = n.first; i < n.first + n.count; ++i) {
       const Face& f = faces_[static_cast<std::size_t>(i)];
       if (f.v[0] == skipped || f.v[1] == skipped || f.v[2] == skipped) continue;
-      // Möller–Trumbore.
-      const Vec3& a = points_[static_cast<std::size_t>(f.v[0])];
-      const Vec3 ab = points_[static_cast<std::size_t>(f.v[1])] - a;
-      const Vec3 ac = points_[static_cast<std::size_t>(f.v[2])] - a;
-      const Vec3 p = OpenMesh::cross(direction, ac);
-      const double det = OpenMesh::dot(ab, p);
-      if (det == 0.0) continue;
-      const double inv_det = 1.0 / det;
-      const Vec3 s = origin - a;
-      const double u = OpenMesh::dot(s, p) * inv_det;
-      if (u < -kTolerance || u > 1.0 + kTolerance) continue;
-      const Vec3 q = OpenMesh::cross(s, ab);
-      const double v = OpenMesh::dot(direction, q) * inv_det;
-      if (v < -kTolerance || u + v > 1.0 + kTolerance) continue;
-      const double t = OpenMesh::dot(ac, q) * inv_det;
-      if (!(t > t_min) || !(t <= best)) continue;
-      best = t;
-      hit.t = t;
+      TriangleHit met{};
+      if (!meet_triangle(ray, points_[static_cast<std::size_t>(f.v[0])],
+                         points_[static_cast<std::size_t>(f.v[1])],
+                         points_[static_cast<std::size_t>(f.v[2])], met))
+        continue;
+      if (!(met.t > t_min) || !(met.t <= best)) continue;
+      best = met.t;
+      hit.t = met.t;
       hit.face = FaceHandle(f.face);
-      hit.bary = {1.0 - u - v, u, v};
+      hit.bary = {1.0 - met.u - met.v, met.u, met.v};
     }
   }
   return hit;

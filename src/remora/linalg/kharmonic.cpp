@@ -79,6 +79,101 @@ void validate(const Mesh& mesh, const Region& region, const KHarmonicOptions& op
           "vertex of that component or make the support smaller");
 }
 
+// Numbers the free vertices in vertex order: system.free_vertices and system.row_of (-1 for a
+// vertex that is not free), over the region's n labels.
+void number_free_vertices(const Region& region, KHarmonicSystem& system) {
+  const auto n = static_cast<Eigen::Index>(region.label.size());
+  system.row_of.assign(static_cast<std::size_t>(n), -1);
+  for (Eigen::Index v = 0; v < n; ++v)
+    if (region.label[static_cast<std::size_t>(v)] == Region::kFree) {
+      system.row_of[static_cast<std::size_t>(v)] = static_cast<int>(system.free_vertices.size());
+      system.free_vertices.push_back(static_cast<int>(v));
+    }
+}
+
+// The inverse vertex areas of the inner factors: 1 / mixed area, floored at 1e-12 times the mean
+// positive area; all 1 for Mean (the Ā^k factor drops out of the rows).
+Eigen::VectorXd inverse_areas(const Mesh& mesh, AreaWeights areas) {
+  const auto n = static_cast<Eigen::Index>(mesh.n_vertices());
+  Eigen::VectorXd inverse_area = Eigen::VectorXd::Ones(n);
+  if (areas == AreaWeights::Mean) return inverse_area;
+  const Eigen::VectorXd area = vertex_areas_mixed(mesh);
+  double mean = 0;
+  Eigen::Index counted = 0;
+  for (Eigen::Index v = 0; v < n; ++v)
+    if (area[v] > 0) {
+      mean += area[v];
+      ++counted;
+    }
+  mean = counted > 0 ? mean / static_cast<double>(counted) : 1.0;
+  // A vertex whose faces all have zero area (needles of a raw scan) gets a floor instead of
+  // an infinite inverse; its row of W is zero anyway.
+  for (Eigen::Index v = 0; v < n; ++v) inverse_area[v] = 1.0 / std::max(area[v], 1e-12 * mean);
+  return inverse_area;
+}
+
+// Rows `free_vertices` of −W, in that order (free × all vertices).
+RowMatrix free_rows(const SparseMatrix& minus_w, const std::vector<int>& free_vertices) {
+  const auto nf = static_cast<Eigen::Index>(free_vertices.size());
+  RowMatrix rows(nf, minus_w.cols());
+  std::vector<Triplet> triplets;
+  triplets.reserve(static_cast<std::size_t>(nf) * 7);
+  for (Eigen::Index r = 0; r < nf; ++r) {
+    const int v = free_vertices[static_cast<std::size_t>(r)];
+    for (SparseMatrix::InnerIterator it(minus_w, v); it; ++it) // W is symmetric: column = row
+      triplets.emplace_back(r, it.row(), it.value());
+  }
+  rows.setFromTriplets(triplets.begin(), triplets.end());
+  return rows;
+}
+
+// The free vertices' rows of the k-th power: R = rows F of (−W), then R ← R · A⁻¹(−W) for each
+// further power; for Mixed areas each row is then scaled by its vertex's inverse area.
+RowMatrix power_rows(const SparseMatrix& minus_w, const Eigen::VectorXd& inverse_area,
+                     const std::vector<int>& free_vertices, const KHarmonicOptions& options) {
+  RowMatrix rows = free_rows(minus_w, free_vertices);
+  if (options.k > 1) {
+    const SparseMatrix step = inverse_area.asDiagonal() * minus_w;
+    for (int power = 1; power < options.k; ++power) rows = RowMatrix(rows * step);
+  }
+  if (options.areas == AreaWeights::Mixed)
+    for (Eigen::Index r = 0; r < rows.rows(); ++r)
+      rows.row(r) *= inverse_area[free_vertices[static_cast<std::size_t>(r)]];
+  return rows;
+}
+
+// Splits the non-zero entries of `rows` by column: the free vertices' into system.matrix (by
+// row_of), the constrained vertices' into system.coupling (numbered in vertex order into
+// system.constrained_vertices).
+void split_columns(const RowMatrix& rows, KHarmonicSystem& system) {
+  const Eigen::Index nf = rows.rows();
+  std::vector<int> column_of(static_cast<std::size_t>(rows.cols()), -1);
+  std::vector<Triplet> free_part, constrained_part;
+  free_part.reserve(static_cast<std::size_t>(rows.nonZeros()));
+  for (Eigen::Index r = 0; r < nf; ++r)
+    for (RowMatrix::InnerIterator it(rows, r); it; ++it) {
+      if (it.value() == 0.0) continue;
+      const auto v = static_cast<std::size_t>(it.col());
+      if (system.row_of[v] >= 0) {
+        free_part.emplace_back(r, system.row_of[v], it.value());
+      } else {
+        if (column_of[v] < 0) column_of[v] = 0; // numbered below, in vertex order
+        constrained_part.emplace_back(r, static_cast<Eigen::Index>(v), it.value());
+      }
+    }
+  for (std::size_t v = 0; v < column_of.size(); ++v)
+    if (column_of[v] >= 0) {
+      column_of[v] = static_cast<int>(system.constrained_vertices.size());
+      system.constrained_vertices.push_back(static_cast<int>(v));
+    }
+  for (Triplet& t : constrained_part)
+    t = Triplet(t.row(), column_of[static_cast<std::size_t>(t.col())], t.value());
+  system.matrix.resize(nf, nf);
+  system.matrix.setFromTriplets(free_part.begin(), free_part.end());
+  system.coupling.resize(nf, static_cast<Eigen::Index>(system.constrained_vertices.size()));
+  system.coupling.setFromTriplets(constrained_part.begin(), constrained_part.end());
+}
+
 } // namespace
 
 int Region::handle_count() const {
@@ -129,81 +224,12 @@ Eigen::MatrixXd KHarmonicSystem::gather_constrained(const Eigen::MatrixXd& posit
 KHarmonicSystem assemble_kharmonic(const Mesh& mesh, const Region& region,
                                    const KHarmonicOptions& options) {
   validate(mesh, region, options);
-  const auto n = static_cast<Eigen::Index>(mesh.n_vertices());
   KHarmonicSystem system;
   system.symmetric = options.areas != AreaWeights::Mixed;
-  system.row_of.assign(static_cast<std::size_t>(n), -1);
-  for (Eigen::Index v = 0; v < n; ++v)
-    if (region.label[static_cast<std::size_t>(v)] == Region::kFree) {
-      system.row_of[static_cast<std::size_t>(v)] = static_cast<int>(system.free_vertices.size());
-      system.free_vertices.push_back(static_cast<int>(v));
-    }
-  const auto nf = static_cast<Eigen::Index>(system.free_vertices.size());
-
+  number_free_vertices(region, system);
   const SparseMatrix minus_w = -cotan_weights(mesh);
-  // Inverse areas for the inner factors (all 1 for Mean: the Ā^k factor drops out of the rows).
-  Eigen::VectorXd inverse_area = Eigen::VectorXd::Ones(n);
-  if (options.areas != AreaWeights::Mean) {
-    const Eigen::VectorXd area = vertex_areas_mixed(mesh);
-    double mean = 0;
-    Eigen::Index counted = 0;
-    for (Eigen::Index v = 0; v < n; ++v)
-      if (area[v] > 0) {
-        mean += area[v];
-        ++counted;
-      }
-    mean = counted > 0 ? mean / static_cast<double>(counted) : 1.0;
-    // A vertex whose faces all have zero area (needles of a raw scan) gets a floor instead of
-    // an infinite inverse; its row of W is zero anyway.
-    for (Eigen::Index v = 0; v < n; ++v) inverse_area[v] = 1.0 / std::max(area[v], 1e-12 * mean);
-  }
-
-  // R = rows F of (−W), then R ← R · A⁻¹(−W) for each further power.
-  RowMatrix rows(nf, n);
-  {
-    std::vector<Triplet> triplets;
-    triplets.reserve(static_cast<std::size_t>(nf) * 7);
-    for (Eigen::Index r = 0; r < nf; ++r) {
-      const int v = system.free_vertices[static_cast<std::size_t>(r)];
-      for (SparseMatrix::InnerIterator it(minus_w, v); it; ++it) // W is symmetric: column = row
-        triplets.emplace_back(r, it.row(), it.value());
-    }
-    rows.setFromTriplets(triplets.begin(), triplets.end());
-  }
-  if (options.k > 1) {
-    const SparseMatrix step = inverse_area.asDiagonal() * minus_w;
-    for (int power = 1; power < options.k; ++power) rows = RowMatrix(rows * step);
-  }
-  if (options.areas == AreaWeights::Mixed)
-    for (Eigen::Index r = 0; r < nf; ++r)
-      rows.row(r) *= inverse_area[system.free_vertices[static_cast<std::size_t>(r)]];
-
-  // Split the columns into free and constrained.
-  std::vector<int> column_of(static_cast<std::size_t>(n), -1);
-  std::vector<Triplet> free_part, constrained_part;
-  free_part.reserve(static_cast<std::size_t>(rows.nonZeros()));
-  for (Eigen::Index r = 0; r < nf; ++r)
-    for (RowMatrix::InnerIterator it(rows, r); it; ++it) {
-      if (it.value() == 0.0) continue;
-      const auto v = static_cast<std::size_t>(it.col());
-      if (system.row_of[v] >= 0) {
-        free_part.emplace_back(r, system.row_of[v], it.value());
-      } else {
-        if (column_of[v] < 0) column_of[v] = 0; // numbered below, in vertex order
-        constrained_part.emplace_back(r, static_cast<Eigen::Index>(v), it.value());
-      }
-    }
-  for (std::size_t v = 0; v < column_of.size(); ++v)
-    if (column_of[v] >= 0) {
-      column_of[v] = static_cast<int>(system.constrained_vertices.size());
-      system.constrained_vertices.push_back(static_cast<int>(v));
-    }
-  for (Triplet& t : constrained_part)
-    t = Triplet(t.row(), column_of[static_cast<std::size_t>(t.col())], t.value());
-  system.matrix.resize(nf, nf);
-  system.matrix.setFromTriplets(free_part.begin(), free_part.end());
-  system.coupling.resize(nf, static_cast<Eigen::Index>(system.constrained_vertices.size()));
-  system.coupling.setFromTriplets(constrained_part.begin(), constrained_part.end());
+  const Eigen::VectorXd inverse_area = inverse_areas(mesh, options.areas);
+  split_columns(power_rows(minus_w, inverse_area, system.free_vertices, options), system);
   if (system.symmetric) {
     // Exactly symmetric (the products above agree with their transposes only to round-off).
     const SparseMatrix transposed = system.matrix.transpose();

@@ -328,12 +328,14 @@ private:
   std::vector<double> band_;
 };
 
-} // namespace
+// ---- Reverse Cuthill-McKee ---------------------------------------------------------------------
 
-std::vector<int> reverse_cuthill_mckee(const Sparse& a) {
+using Adjacency = std::vector<std::vector<int>>;
+
+// The pattern of A + Aᵀ without the diagonal: each row's neighbours, sorted, without repeats.
+Adjacency symmetric_adjacency(const Sparse& a) {
   const auto n = static_cast<int>(a.rows());
-  // Symmetric adjacency (the pattern of A + Aᵀ without the diagonal).
-  std::vector<std::vector<int>> adjacent(static_cast<std::size_t>(n));
+  Adjacency adjacent(static_cast<std::size_t>(n));
   for (int j = 0; j < a.outerSize(); ++j)
     for (Sparse::InnerIterator it(a, j); it; ++it) {
       const int i = static_cast<int>(it.row());
@@ -341,72 +343,113 @@ std::vector<int> reverse_cuthill_mckee(const Sparse& a) {
       adjacent[static_cast<std::size_t>(i)].push_back(j);
       adjacent[static_cast<std::size_t>(j)].push_back(i);
     }
-  std::vector<int> degree(static_cast<std::size_t>(n));
-  for (int i = 0; i < n; ++i) {
-    auto& adj = adjacent[static_cast<std::size_t>(i)];
+  for (auto& adj : adjacent) {
     std::sort(adj.begin(), adj.end());
     adj.erase(std::unique(adj.begin(), adj.end()), adj.end());
-    degree[static_cast<std::size_t>(i)] = static_cast<int>(adj.size());
   }
-  std::vector<int> level(static_cast<std::size_t>(n), -1);
-  // Breadth-first levels from `root` over its (unnumbered) component into `touched`; returns the
-  // depth of the last level. The caller resets `level` of the touched vertices to -1.
-  auto levels_from = [&](int root, std::vector<int>& touched) {
-    touched.clear();
-    touched.push_back(root);
-    level[static_cast<std::size_t>(root)] = 0;
-    for (std::size_t q = 0; q < touched.size(); ++q) {
-      const int u = touched[q];
-      for (int w : adjacent[static_cast<std::size_t>(u)])
-        if (level[static_cast<std::size_t>(w)] < 0) {
-          level[static_cast<std::size_t>(w)] = level[static_cast<std::size_t>(u)] + 1;
-          touched.push_back(w);
+  return adjacent;
+}
+
+// Breadth-first level structures of a graph, one component at a time.
+class Levels {
+public:
+  explicit Levels(const Adjacency& adjacent) : adjacent_(adjacent), level_(adjacent.size(), -1) {}
+
+  /// The levels from `root` over its component, whose levels must be unset; returns the depth
+  /// of the last level.
+  int build(int root) {
+    touched_.clear();
+    touched_.push_back(root);
+    level_[static_cast<std::size_t>(root)] = 0;
+    for (std::size_t q = 0; q < touched_.size(); ++q) {
+      const int u = touched_[q];
+      for (int w : adjacent_[static_cast<std::size_t>(u)])
+        if (level_[static_cast<std::size_t>(w)] < 0) {
+          level_[static_cast<std::size_t>(w)] = level_[static_cast<std::size_t>(u)] + 1;
+          touched_.push_back(w);
         }
     }
-    return level[static_cast<std::size_t>(touched.back())];
-  };
+    return level_[static_cast<std::size_t>(touched_.back())];
+  }
+
+  /// The vertex of level `depth` of the last build with the smallest degree (the first visited
+  /// among equals).
+  int smallest_degree_at(int depth, const std::vector<int>& degree) const {
+    int best = -1;
+    for (int u : touched_)
+      if (level_[static_cast<std::size_t>(u)] == depth &&
+          (best < 0 ||
+           degree[static_cast<std::size_t>(u)] < degree[static_cast<std::size_t>(best)]))
+        best = u;
+    return best;
+  }
+
+  /// Unsets the levels of the last build.
+  void clear() {
+    for (int u : touched_) level_[static_cast<std::size_t>(u)] = -1;
+  }
+
+private:
+  const Adjacency& adjacent_;
+  std::vector<int> level_;   // -1 where unset
+  std::vector<int> touched_; // the last build's component, in visiting order
+};
+
+// A pseudo-peripheral vertex of seed's component (George & Liu): from seed, jump to a
+// smallest-degree vertex of the last level while the eccentricity grows (at most 8 jumps).
+// Leaves every level unset.
+int pseudo_peripheral_root(int seed, const std::vector<int>& degree, Levels& levels) {
+  int root = seed, depth = levels.build(root);
+  for (int tries = 0; tries < 8; ++tries) {
+    const int best = levels.smallest_degree_at(depth, degree);
+    levels.clear();
+    const int next_depth = levels.build(best);
+    if (next_depth <= depth) break;
+    root = best;
+    depth = next_depth;
+  }
+  levels.clear();
+  return root;
+}
+
+// Appends root's component to `order` in Cuthill-McKee order (breadth first, each vertex's
+// unnumbered neighbours by increasing degree, then index), marking it in `numbered`.
+void cuthill_mckee(int root, const Adjacency& adjacent, const std::vector<int>& degree,
+                   std::vector<char>& numbered, std::vector<int>& order) {
+  const std::size_t start = order.size();
+  order.push_back(root);
+  numbered[static_cast<std::size_t>(root)] = 1;
+  std::vector<int> next;
+  for (std::size_t q = start; q < order.size(); ++q) {
+    next.clear();
+    for (int w : adjacent[static_cast<std::size_t>(order[q])])
+      if (!numbered[static_cast<std::size_t>(w)]) {
+        numbered[static_cast<std::size_t>(w)] = 1;
+        next.push_back(w);
+      }
+    std::sort(next.begin(), next.end(), [&](int x, int y) {
+      const int dx = degree[static_cast<std::size_t>(x)], dy = degree[static_cast<std::size_t>(y)];
+      return dx != dy ? dx < dy : x < y;
+    });
+    order.insert(order.end(), next.begin(), next.end());
+  }
+}
+
+} // namespace
+
+std::vector<int> reverse_cuthill_mckee(const Sparse& a) {
+  const auto n = static_cast<int>(a.rows());
+  const Adjacency adjacent = symmetric_adjacency(a);
+  std::vector<int> degree(static_cast<std::size_t>(n));
+  for (std::size_t i = 0; i < adjacent.size(); ++i)
+    degree[i] = static_cast<int>(adjacent[i].size());
+  Levels levels(adjacent);
   std::vector<int> order;
   order.reserve(static_cast<std::size_t>(n));
   std::vector<char> numbered(static_cast<std::size_t>(n), 0);
-  std::vector<int> touched;
   for (int seed = 0; seed < n; ++seed) {
     if (numbered[static_cast<std::size_t>(seed)]) continue;
-    // Pseudo-peripheral root (George & Liu): jump to a smallest-degree vertex of the last level
-    // while the eccentricity grows.
-    int root = seed, depth = levels_from(root, touched);
-    for (int tries = 0; tries < 8; ++tries) {
-      int best = -1;
-      for (int u : touched)
-        if (level[static_cast<std::size_t>(u)] == depth &&
-            (best < 0 ||
-             degree[static_cast<std::size_t>(u)] < degree[static_cast<std::size_t>(best)]))
-          best = u;
-      for (int u : touched) level[static_cast<std::size_t>(u)] = -1;
-      const int next_depth = levels_from(best, touched);
-      if (next_depth <= depth) break;
-      root = best;
-      depth = next_depth;
-    }
-    for (int u : touched) level[static_cast<std::size_t>(u)] = -1;
-    // Cuthill-McKee from the root.
-    const std::size_t start = order.size();
-    order.push_back(root);
-    numbered[static_cast<std::size_t>(root)] = 1;
-    std::vector<int> next;
-    for (std::size_t q = start; q < order.size(); ++q) {
-      next.clear();
-      for (int w : adjacent[static_cast<std::size_t>(order[q])])
-        if (!numbered[static_cast<std::size_t>(w)]) {
-          numbered[static_cast<std::size_t>(w)] = 1;
-          next.push_back(w);
-        }
-      std::sort(next.begin(), next.end(), [&](int x, int y) {
-        const int dx = degree[static_cast<std::size_t>(x)],
-                  dy = degree[static_cast<std::size_t>(y)];
-        return dx != dy ? dx < dy : x < y;
-      });
-      order.insert(order.end(), next.begin(), next.end());
-    }
+    cuthill_mckee(pseudo_peripheral_root(seed, degree, levels), adjacent, degree, numbered, order);
   }
   std::reverse(order.begin(), order.end());
   return order;

@@ -18,6 +18,81 @@ struct ForwardReference {
   std::uint64_t line;
 };
 
+// `line` trimmed on the right; when it ends in a backslash, it and the lines it continues onto
+// (taken from `lines`), joined with spaces into `joined` in place of the backslashes.
+std::string_view join_continued(std::string_view line, LineReader& lines, std::string& joined) {
+  line = trim_right(line);
+  if (line.empty() || line.back() != '\\') return line;
+  joined.assign(line.substr(0, line.size() - 1));
+  std::string_view more;
+  while (lines.next(more)) {
+    more = trim_right(more);
+    joined += ' ';
+    if (more.empty() || more.back() != '\\') {
+      joined += more;
+      break;
+    }
+    joined += more.substr(0, more.size() - 1);
+  }
+  return joined;
+}
+
+// The 0-based vertex of a face corner `i`, `i/t`, `i//n` or `i/t/n` (a negative i counts back
+// from the `seen` vertices read so far); throws IoError for index 0, a relative index before the
+// first vertex, or an index too large for 32 bits.
+std::int64_t corner_vertex(std::string_view token, std::int64_t seen, const std::string& name,
+                           std::uint64_t line_no) {
+  const std::string_view vertex_token = token.substr(0, token.find('/'));
+  const std::int64_t index = to_int(vertex_token, name, line_no, "vertex index of a face");
+  std::int64_t vertex = 0;
+  if (index > 0) {
+    vertex = index - 1;
+  } else if (index < 0) {
+    vertex = seen + index;
+    if (vertex < 0)
+      throw IoError(name,
+                    "relative vertex index " + std::to_string(index) +
+                        " points before the first vertex (only " + std::to_string(seen) +
+                        " vertices precede this face)",
+                    line_no);
+  } else {
+    throw IoError(name, "vertex index 0 in a face (OBJ indices start at 1)", line_no);
+  }
+  if (vertex >= static_cast<std::int64_t>(std::numeric_limits<std::uint32_t>::max()))
+    throw IoError(name, "vertex index " + std::to_string(index) + " is too large", line_no);
+  return vertex;
+}
+
+// The corners of an `f` statement (`rest`: what follows the keyword) into `corners`; a corner
+// past the `seen` vertices read so far goes into `forward`. Throws IoError for fewer than 3.
+void read_face(std::string_view rest, std::int64_t seen, const std::string& name,
+               std::uint64_t line_no, std::vector<std::uint32_t>& corners,
+               std::vector<ForwardReference>& forward) {
+  corners.clear();
+  for (std::string_view token = next_token(rest); !token.empty(); token = next_token(rest)) {
+    const std::int64_t vertex = corner_vertex(token, seen, name, line_no);
+    if (vertex >= seen) forward.push_back({vertex, line_no});
+    corners.push_back(static_cast<std::uint32_t>(vertex));
+  }
+  if (corners.size() < 3)
+    throw IoError(name,
+                  "face has " + std::to_string(corners.size()) + " corner" +
+                      plural(corners.size()) + "; a face needs at least 3",
+                  line_no);
+}
+
+// Throws IoError at the first face corner that refers past the file's `count` vertices.
+void check_forward(const std::vector<ForwardReference>& forward, std::int64_t count,
+                   const std::string& name) {
+  for (const ForwardReference& ref : forward) {
+    if (ref.vertex >= count)
+      throw IoError(name,
+                    "face refers to vertex " + std::to_string(ref.vertex + 1) +
+                        " but the file has " + std::to_string(count) + " vertices",
+                    ref.line);
+  }
+}
+
 } // namespace
 
 SoupFile read_obj(std::string_view bytes, const std::string& name) {
@@ -38,23 +113,7 @@ SoupFile read_obj(std::string_view bytes, const std::string& name) {
   std::string_view raw;
   while (lines.next(raw)) {
     const std::uint64_t line_no = lines.line();
-    std::string_view line = trim_right(raw);
-    if (!line.empty() && line.back() == '\\') {
-      // A trailing backslash continues the statement on the next line.
-      joined.assign(line.substr(0, line.size() - 1));
-      std::string_view more;
-      while (lines.next(more)) {
-        more = trim_right(more);
-        joined += ' ';
-        if (more.empty() || more.back() != '\\') {
-          joined += more;
-          break;
-        }
-        joined += more.substr(0, more.size() - 1);
-      }
-      line = joined;
-    }
-    line = strip_comment(line);
+    const std::string_view line = strip_comment(join_continued(raw, lines, joined));
     if (line.empty()) continue;
 
     std::string_view rest = line;
@@ -63,36 +122,8 @@ SoupFile read_obj(std::string_view bytes, const std::string& name) {
       // `v x y z [w] [r g b]`: anything after z is read past.
       soup.points.push_back(parse_point(rest, soup.points.size() + 1, name, line_no));
     } else if (key == "f") {
-      corners.clear();
-      const auto seen = static_cast<std::int64_t>(soup.points.size());
-      for (std::string_view token = next_token(rest); !token.empty(); token = next_token(rest)) {
-        // `i`, `i/t`, `i//n`, `i/t/n`: only the vertex index matters.
-        const std::string_view vertex_token = token.substr(0, token.find('/'));
-        const std::int64_t index = to_int(vertex_token, name, line_no, "vertex index of a face");
-        std::int64_t vertex = 0;
-        if (index > 0) {
-          vertex = index - 1;
-        } else if (index < 0) {
-          vertex = seen + index;
-          if (vertex < 0)
-            throw IoError(name,
-                          "relative vertex index " + std::to_string(index) +
-                              " points before the first vertex (only " + std::to_string(seen) +
-                              " vertices precede this face)",
-                          line_no);
-        } else {
-          throw IoError(name, "vertex index 0 in a face (OBJ indices start at 1)", line_no);
-        }
-        if (vertex >= static_cast<std::int64_t>(std::numeric_limits<std::uint32_t>::max()))
-          throw IoError(name, "vertex index " + std::to_string(index) + " is too large", line_no);
-        if (vertex >= seen) forward.push_back({vertex, line_no});
-        corners.push_back(static_cast<std::uint32_t>(vertex));
-      }
-      if (corners.size() < 3)
-        throw IoError(name,
-                      "face has " + std::to_string(corners.size()) + " corner" +
-                          plural(corners.size()) + "; a face needs at least 3",
-                      line_no);
+      read_face(rest, static_cast<std::int64_t>(soup.points.size()), name, line_no, corners,
+                forward);
       soup.add_polygon(corners.data(), corners.size());
     } else {
       skipped.add(key);
@@ -100,13 +131,7 @@ SoupFile read_obj(std::string_view bytes, const std::string& name) {
   }
 
   const auto count = static_cast<std::int64_t>(soup.points.size());
-  for (const ForwardReference& ref : forward) {
-    if (ref.vertex >= count)
-      throw IoError(name,
-                    "face refers to vertex " + std::to_string(ref.vertex + 1) +
-                        " but the file has " + std::to_string(count) + " vertices",
-                    ref.line);
-  }
+  check_forward(forward, count, name);
   if (soup.num_polygons() == 0)
     throw IoError(name, "no faces: the file has " + std::to_string(count) +
                             " vertices and no 'f' lines (an empty mesh cannot be loaded)");

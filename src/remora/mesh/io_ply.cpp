@@ -143,6 +143,76 @@ PlyType parse_type(std::string_view token, const std::string& name, std::uint64_
                 line);
 }
 
+// `format ENCODING 1.0` (`rest`: what follows the keyword): sets the encoding of `h`; throws
+// IoError for an unknown encoding, another version or a second format line.
+void parse_format(std::string_view rest, const std::string& name, std::uint64_t line,
+                  bool& have_format, PlyHeader& h) {
+  const std::string_view encoding = next_token(rest);
+  const std::string_view version = next_token(rest);
+  if (encoding == "ascii") {
+    h.ascii = true;
+  } else if (encoding == "binary_little_endian") {
+    h.ascii = false;
+    h.big_endian = false;
+  } else if (encoding == "binary_big_endian") {
+    h.ascii = false;
+    h.big_endian = true;
+  } else {
+    throw IoError(name,
+                  "unknown PLY format '" + std::string(encoding) +
+                      "' (known: ascii, binary_little_endian, binary_big_endian)",
+                  line);
+  }
+  if (version != "1.0" || !next_token(rest).empty())
+    throw IoError(
+        name, "unsupported format line: expected 'format " + std::string(encoding) + " 1.0'", line);
+  if (have_format) throw IoError(name, "a second 'format' line", line);
+  have_format = true;
+  h.encoding = encoding;
+}
+
+// `element NAME COUNT` (`rest`: what follows the keyword), without properties yet.
+PlyElement parse_element(std::string_view rest, const std::string& name, std::uint64_t line) {
+  PlyElement e;
+  e.name = next_token(rest);
+  const std::string_view count = next_token(rest);
+  if (e.name.empty() || count.empty() || !next_token(rest).empty())
+    throw IoError(name, "bad element line: expected 'element NAME COUNT'", line);
+  const std::int64_t n = to_int(count, name, line, "element count");
+  if (n < 0) throw IoError(name, "negative element count " + std::to_string(n), line);
+  e.count = static_cast<std::uint64_t>(n);
+  e.line = line;
+  return e;
+}
+
+// `property TYPE NAME` or `property list COUNT_TYPE TYPE NAME` (`rest`: what follows the
+// keyword); a list's length type must be an integer type.
+PlyProperty parse_property(std::string_view rest, const std::string& name, std::uint64_t line) {
+  PlyProperty p;
+  const std::string_view type = next_token(rest);
+  if (type == "list") {
+    p.list = true;
+    const std::string_view count_type = next_token(rest);
+    const std::string_view item_type = next_token(rest);
+    if (count_type.empty() || item_type.empty())
+      throw IoError(name, "bad property line: expected 'property list COUNT_TYPE TYPE NAME'", line);
+    p.count_type = parse_type(count_type, name, line);
+    p.type = parse_type(item_type, name, line);
+    if (!is_integer(p.count_type))
+      throw IoError(
+          name, "list length type '" + std::string(count_type) + "' is not an integer type", line);
+  } else {
+    if (type.empty()) throw IoError(name, "bad property line: no type", line);
+    p.type = parse_type(type, name, line);
+  }
+  p.name = next_token(rest);
+  if (p.name.empty() || !next_token(rest).empty())
+    throw IoError(name, "bad property line: expected 'property TYPE NAME'", line);
+  return p;
+}
+
+// The header up to and including `end_header`, each line checked to be text; throws IoError for
+// a first line other than `ply`, an unknown or malformed line, or a missing format line.
 PlyHeader parse_header(std::string_view bytes, const std::string& name) {
   if (bytes.empty()) throw IoError(name, "no faces: the file is empty");
   PlyHeader h;
@@ -168,65 +238,12 @@ PlyHeader parse_header(std::string_view bytes, const std::string& name) {
     if (key == "end_header") {
       ended = true;
     } else if (key == "format") {
-      const std::string_view encoding = next_token(rest);
-      const std::string_view version = next_token(rest);
-      if (encoding == "ascii") {
-        h.ascii = true;
-      } else if (encoding == "binary_little_endian") {
-        h.ascii = false;
-        h.big_endian = false;
-      } else if (encoding == "binary_big_endian") {
-        h.ascii = false;
-        h.big_endian = true;
-      } else {
-        throw IoError(name,
-                      "unknown PLY format '" + std::string(encoding) +
-                          "' (known: ascii, binary_little_endian, binary_big_endian)",
-                      line);
-      }
-      if (version != "1.0" || !next_token(rest).empty())
-        throw IoError(
-            name, "unsupported format line: expected 'format " + std::string(encoding) + " 1.0'",
-            line);
-      if (have_format) throw IoError(name, "a second 'format' line", line);
-      have_format = true;
-      h.encoding = encoding;
+      parse_format(rest, name, line, have_format, h);
     } else if (key == "element") {
-      PlyElement e;
-      e.name = next_token(rest);
-      const std::string_view count = next_token(rest);
-      if (e.name.empty() || count.empty() || !next_token(rest).empty())
-        throw IoError(name, "bad element line: expected 'element NAME COUNT'", line);
-      const std::int64_t n = to_int(count, name, line, "element count");
-      if (n < 0) throw IoError(name, "negative element count " + std::to_string(n), line);
-      e.count = static_cast<std::uint64_t>(n);
-      e.line = line;
-      h.elements.push_back(std::move(e));
+      h.elements.push_back(parse_element(rest, name, line));
     } else if (key == "property") {
       if (h.elements.empty()) throw IoError(name, "'property' before any 'element' line", line);
-      PlyProperty p;
-      const std::string_view type = next_token(rest);
-      if (type == "list") {
-        p.list = true;
-        const std::string_view count_type = next_token(rest);
-        const std::string_view item_type = next_token(rest);
-        if (count_type.empty() || item_type.empty())
-          throw IoError(name, "bad property line: expected 'property list COUNT_TYPE TYPE NAME'",
-                        line);
-        p.count_type = parse_type(count_type, name, line);
-        p.type = parse_type(item_type, name, line);
-        if (!is_integer(p.count_type))
-          throw IoError(name,
-                        "list length type '" + std::string(count_type) + "' is not an integer type",
-                        line);
-      } else {
-        if (type.empty()) throw IoError(name, "bad property line: no type", line);
-        p.type = parse_type(type, name, line);
-      }
-      p.name = next_token(rest);
-      if (p.name.empty() || !next_token(rest).empty())
-        throw IoError(name, "bad property line: expected 'property TYPE NAME'", line);
-      h.elements.back().properties.push_back(std::move(p));
+      h.elements.back().properties.push_back(parse_property(rest, name, line));
     } else {
       throw IoError(name, "unknown header line starting with '" + std::string(key) + "'", line);
     }
@@ -542,97 +559,132 @@ void add_strip(const std::vector<std::uint32_t>& s, PolygonSoup& soup, std::size
   }
 }
 
+// Reads past property p of the current record (a list with its length).
+template <class Source>
+void skip_property(Source& src, const PlyProperty& p) {
+  if (p.list)
+    src.skip_items(p, src.read_count(p));
+  else
+    src.skip(p);
+}
+
+// The vertex element e (number ei in the header): x y z of each record into soup.points, the
+// other properties read past; fails at a point that is not finite. Reserves `reserve` points.
+template <class Source>
+void read_vertices(Source& src, const PlyElement& e, std::size_t ei, std::size_t reserve,
+                   PolygonSoup& soup) {
+  soup.points.reserve(reserve);
+  for (std::uint64_t r = 0; r < e.count; ++r) {
+    src.begin_record(ei, r);
+    Vec3 point(0, 0, 0);
+    for (const PlyProperty& p : e.properties) {
+      if (p.list || p.role == Role::Skip)
+        skip_property(src, p);
+      else
+        point[static_cast<int>(p.role) - static_cast<int>(Role::X)] = src.read_double(p);
+    }
+    src.end_record();
+    if (!is_finite(point))
+      src.fail_record(non_finite_problem(point, "vertex " + std::to_string(r)));
+    soup.points.push_back(point);
+  }
+}
+
+// The index list p of record r of the face or strip element e into `corners`, each index below
+// `vertex_count`; in a strip, -1 ends the strip so far, whose triangles go into soup and are
+// counted in `faces`. Fails at a face of fewer than 3 corners or an index out of range.
+template <class Source>
+void read_indices(Source& src, const PlyProperty& p, const PlyElement& e, std::uint64_t r,
+                  std::uint64_t vertex_count, std::vector<std::uint32_t>& corners,
+                  PolygonSoup& soup, std::size_t& faces) {
+  const bool strips = e.kind == Kind::Strips;
+  const std::uint64_t n = src.read_count(p);
+  if (!strips && n < 3)
+    src.fail("face " + std::to_string(r) + " has " + std::to_string(n) +
+             " corners; a face needs at least 3");
+  for (std::uint64_t k = 0; k < n; ++k) {
+    const std::int64_t index = src.read_int(p);
+    if (index >= 0 && static_cast<std::uint64_t>(index) < vertex_count) {
+      corners.push_back(static_cast<std::uint32_t>(index));
+    } else if (strips && index == -1) {
+      add_strip(corners, soup, faces);
+      corners.clear();
+    } else if (index < 0) {
+      src.fail(record_label(e, r) + " has the negative vertex index " + std::to_string(index) +
+               (strips ? " (only -1 may separate strips)" : ""));
+    } else {
+      src.fail(record_label(e, r) + " refers to vertex " + std::to_string(index) +
+               " but the file has " + std::to_string(vertex_count) + " vertices");
+    }
+  }
+}
+
+// The face or strip element e (number ei in the header) into soup: a polygon per face record,
+// the triangles of its strips per strip record; returns how many faces it added. Reserves room
+// for `reserve` faces of a face element.
+template <class Source>
+std::size_t read_faces(Source& src, const PlyElement& e, std::size_t ei, std::uint64_t vertex_count,
+                       std::size_t reserve, PolygonSoup& soup) {
+  const bool strips = e.kind == Kind::Strips;
+  if (!strips) {
+    soup.offsets.reserve(soup.offsets.size() + reserve);
+    soup.indices.reserve(soup.indices.size() + 3 * reserve);
+  }
+  std::vector<std::uint32_t> corners;
+  std::size_t faces = 0;
+  for (std::uint64_t r = 0; r < e.count; ++r) {
+    src.begin_record(ei, r);
+    corners.clear();
+    for (const PlyProperty& p : e.properties) {
+      if (p.role == Role::Indices)
+        read_indices(src, p, e, r, vertex_count, corners, soup, faces);
+      else
+        skip_property(src, p);
+    }
+    src.end_record();
+    if (strips) {
+      add_strip(corners, soup, faces);
+    } else {
+      soup.add_polygon(corners.data(), corners.size());
+      ++faces;
+    }
+  }
+  return faces;
+}
+
+// "element NAME (COUNT)", for FileInfo::skipped.
+std::string skipped_element(const PlyElement& e) {
+  return "element " + e.name + " (" + std::to_string(e.count) + ")";
+}
+
+// The records of every element in header order: vertices and faces into result.soup, the other
+// elements read past and listed in result.info.skipped; fails at data after the last element.
 template <class Source>
 void read_body(Source& src, const PlyHeader& h, std::size_t file_size, SoupFile& result) {
   PolygonSoup& soup = result.soup;
   std::uint64_t vertex_count = 0;
-  std::vector<std::uint32_t> corners;
-
   for (std::size_t ei = 0; ei < h.elements.size(); ++ei) {
     const PlyElement& e = h.elements[ei];
     if (e.properties.empty()) {
       // Records without properties occupy no bytes and no text.
-      if (e.kind == Kind::Skip)
-        result.info.skipped.push_back("element " + e.name + " (" + std::to_string(e.count) + ")");
+      if (e.kind == Kind::Skip) result.info.skipped.push_back(skipped_element(e));
       continue;
     }
+    const std::size_t reserve = reserve_count(e.count, file_size, h.ascii ? 6 : e.min_size);
     switch (e.kind) {
     case Kind::Skip:
       src.skip_element(ei);
-      result.info.skipped.push_back("element " + e.name + " (" + std::to_string(e.count) + ")");
+      result.info.skipped.push_back(skipped_element(e));
       break;
     case Kind::Vertex:
       vertex_count = e.count;
-      soup.points.reserve(reserve_count(e.count, file_size, h.ascii ? 6 : e.min_size));
-      for (std::uint64_t r = 0; r < e.count; ++r) {
-        src.begin_record(ei, r);
-        Vec3 point(0, 0, 0);
-        for (const PlyProperty& p : e.properties) {
-          if (p.list)
-            src.skip_items(p, src.read_count(p));
-          else if (p.role == Role::Skip)
-            src.skip(p);
-          else
-            point[static_cast<int>(p.role) - static_cast<int>(Role::X)] = src.read_double(p);
-        }
-        src.end_record();
-        if (!is_finite(point))
-          src.fail_record(non_finite_problem(point, "vertex " + std::to_string(r)));
-        soup.points.push_back(point);
-      }
+      read_vertices(src, e, ei, reserve, soup);
       result.info.vertices_in_file = soup.points.size();
       break;
     case Kind::Face:
-    case Kind::Strips: {
-      const bool strips = e.kind == Kind::Strips;
-      if (!strips) {
-        const std::size_t n = reserve_count(e.count, file_size, h.ascii ? 6 : e.min_size);
-        soup.offsets.reserve(soup.offsets.size() + n);
-        soup.indices.reserve(soup.indices.size() + 3 * n);
-      }
-      std::size_t faces = 0;
-      for (std::uint64_t r = 0; r < e.count; ++r) {
-        src.begin_record(ei, r);
-        corners.clear();
-        for (const PlyProperty& p : e.properties) {
-          if (p.role != Role::Indices) {
-            if (p.list)
-              src.skip_items(p, src.read_count(p));
-            else
-              src.skip(p);
-            continue;
-          }
-          const std::uint64_t n = src.read_count(p);
-          if (!strips && n < 3)
-            src.fail("face " + std::to_string(r) + " has " + std::to_string(n) +
-                     " corners; a face needs at least 3");
-          for (std::uint64_t k = 0; k < n; ++k) {
-            const std::int64_t index = src.read_int(p);
-            if (index >= 0 && static_cast<std::uint64_t>(index) < vertex_count) {
-              corners.push_back(static_cast<std::uint32_t>(index));
-            } else if (strips && index == -1) {
-              add_strip(corners, soup, faces);
-              corners.clear();
-            } else if (index < 0) {
-              src.fail(record_label(e, r) + " has the negative vertex index " +
-                       std::to_string(index) + (strips ? " (only -1 may separate strips)" : ""));
-            } else {
-              src.fail(record_label(e, r) + " refers to vertex " + std::to_string(index) +
-                       " but the file has " + std::to_string(vertex_count) + " vertices");
-            }
-          }
-        }
-        src.end_record();
-        if (strips) {
-          add_strip(corners, soup, faces);
-        } else {
-          soup.add_polygon(corners.data(), corners.size());
-          ++faces;
-        }
-      }
-      result.info.faces_in_file += faces;
+    case Kind::Strips:
+      result.info.faces_in_file += read_faces(src, e, ei, vertex_count, reserve, soup);
       break;
-    }
     }
   }
   src.finish(h.elements.back());

@@ -52,99 +52,143 @@ SoupFile read_binary_stl(std::string_view bytes, std::uint32_t count, const std:
   return result;
 }
 
+// The ascii STL grammar, one keyword line at a time: `solid`, then per facet `facet`,
+// `outer loop`, `vertex x y z` lines, `endloop`, `endfacet`, and `endsolid`; solids may repeat.
+// Each facet's vertices are appended to the soup as a new polygon.
+class AsciiStlParser {
+public:
+  AsciiStlParser(const std::string& name, PolygonSoup& soup) : name_(name), soup_(soup) {}
+
+  /// Takes line `line`, whose first token is `key` and the tokens after it `rest`; throws
+  /// IoError where the grammar does not allow `key`.
+  void take(std::string_view key, std::string_view rest, std::uint64_t line) {
+    switch (state_) {
+    case State::Outside:
+      outside(key, line);
+      break;
+    case State::Solid:
+      in_solid(key, line);
+      break;
+    case State::Facet:
+      in_facet(key, rest, line);
+      break;
+    case State::Loop:
+      in_loop(key, rest, line);
+      break;
+    case State::LoopDone:
+      if (!iequals(key, "endfacet")) unexpected(key, "'endfacet'", line);
+      state_ = State::Solid;
+      break;
+    }
+    if (soup_.points.size() >= std::numeric_limits<std::uint32_t>::max())
+      throw IoError(name_, "too many vertices", line);
+  }
+
+  /// Throws IoError unless every solid is closed; `last_line` is the file's last line.
+  void finish(std::uint64_t last_line) const {
+    if (state_ != State::Outside)
+      throw IoError(name_,
+                    "the file ends inside a " +
+                        std::string(state_ == State::Solid ? "solid" : "facet") +
+                        " (truncated: no 'endsolid' after " + std::to_string(soup_.num_polygons()) +
+                        " facets)",
+                    last_line);
+  }
+
+private:
+  enum class State { Outside, Solid, Facet, Loop, LoopDone };
+
+  // Between solids: only `solid` may come.
+  void outside(std::string_view key, std::uint64_t line) {
+    if (iequals(key, "solid")) {
+      state_ = State::Solid;
+    } else if (solids_ > 0) {
+      throw IoError(name_,
+                    "data continues after 'endsolid': found '" + std::string(key) +
+                        "' where only another 'solid' may follow",
+                    line);
+    } else {
+      unexpected(key, "'solid'", line);
+    }
+  }
+
+  // Inside a solid, between facets.
+  void in_solid(std::string_view key, std::uint64_t line) {
+    if (iequals(key, "facet")) {
+      state_ = State::Facet; // the stored normal is ignored: the vertex order is what counts
+    } else if (iequals(key, "endsolid")) {
+      state_ = State::Outside;
+      ++solids_;
+    } else {
+      unexpected(key, "'facet' or 'endsolid'", line);
+    }
+  }
+
+  // After `facet`: `outer loop` opens the facet's vertices.
+  void in_facet(std::string_view key, std::string_view rest, std::uint64_t line) {
+    if (!iequals(key, "outer")) unexpected(key, "'outer loop'", line);
+    if (!iequals(next_token(rest), "loop")) unexpected(key, "'outer loop'", line);
+    state_ = State::Loop;
+    loop_start_ = soup_.points.size();
+  }
+
+  // Inside the loop: a vertex, or `endloop`, which adds the facet.
+  void in_loop(std::string_view key, std::string_view rest, std::uint64_t line) {
+    if (iequals(key, "vertex")) {
+      soup_.points.push_back(parse_point(rest, soup_.points.size(), name_, line));
+    } else if (iequals(key, "endloop")) {
+      add_facet(line);
+      state_ = State::LoopDone;
+    } else {
+      unexpected(key, "'vertex' or 'endloop'", line);
+    }
+  }
+
+  // The vertices since the loop opened as one polygon; throws IoError for fewer than 3.
+  void add_facet(std::uint64_t line) {
+    const std::size_t n = soup_.points.size() - loop_start_;
+    if (n < 3)
+      throw IoError(name_,
+                    "facet loop has " + std::to_string(n) + " vertices; a facet needs at least 3",
+                    line);
+    corners_.clear();
+    for (std::size_t i = loop_start_; i < soup_.points.size(); ++i)
+      corners_.push_back(static_cast<std::uint32_t>(i));
+    soup_.add_polygon(corners_.data(), corners_.size());
+  }
+
+  // Throws IoError "expected <expected> but found '<found>'" at `line`.
+  [[noreturn]] void unexpected(std::string_view found, const char* expected,
+                               std::uint64_t line) const {
+    throw IoError(name_,
+                  "expected " + std::string(expected) + " but found '" + std::string(found) + "'",
+                  line);
+  }
+
+  const std::string& name_;
+  PolygonSoup& soup_;
+  State state_ = State::Outside;
+  std::size_t solids_ = 0;     // solids closed so far
+  std::size_t loop_start_ = 0; // the first vertex of the open loop
+  std::vector<std::uint32_t> corners_;
+};
+
 SoupFile read_ascii_stl(std::string_view bytes, const std::string& name) {
   check_text(bytes, name);
   SoupFile result;
   result.info.format = "stl";
   result.info.encoding = "ascii";
   PolygonSoup& soup = result.soup;
-
-  enum class State { Outside, Solid, Facet, Loop, LoopDone };
-  State state = State::Outside;
-  std::size_t solids = 0;
-  std::size_t loop_start = 0;
-  std::vector<std::uint32_t> corners;
-  const auto unexpected = [&name](std::string_view found, const char* expected,
-                                  std::uint64_t line) {
-    throw IoError(name,
-                  "expected " + std::string(expected) + " but found '" + std::string(found) + "'",
-                  line);
-  };
+  AsciiStlParser parser(name, soup);
 
   LineReader lines(bytes);
   std::string_view raw;
   while (lines.next(raw)) {
     std::string_view rest = raw;
     const std::string_view key = next_token(rest);
-    if (key.empty()) continue;
-    const std::uint64_t line = lines.line();
-    switch (state) {
-    case State::Outside:
-      if (iequals(key, "solid")) {
-        state = State::Solid;
-      } else if (solids > 0) {
-        throw IoError(name,
-                      "data continues after 'endsolid': found '" + std::string(key) +
-                          "' where only another 'solid' may follow",
-                      line);
-      } else {
-        unexpected(key, "'solid'", line);
-      }
-      break;
-    case State::Solid:
-      if (iequals(key, "facet")) {
-        state = State::Facet; // the stored normal is ignored: the vertex order is what counts
-      } else if (iequals(key, "endsolid")) {
-        state = State::Outside;
-        ++solids;
-      } else {
-        unexpected(key, "'facet' or 'endsolid'", line);
-      }
-      break;
-    case State::Facet:
-      if (iequals(key, "outer")) {
-        if (!iequals(next_token(rest), "loop")) unexpected(key, "'outer loop'", line);
-        state = State::Loop;
-        loop_start = soup.points.size();
-      } else {
-        unexpected(key, "'outer loop'", line);
-      }
-      break;
-    case State::Loop:
-      if (iequals(key, "vertex")) {
-        soup.points.push_back(parse_point(rest, soup.points.size(), name, line));
-      } else if (iequals(key, "endloop")) {
-        const std::size_t n = soup.points.size() - loop_start;
-        if (n < 3)
-          throw IoError(
-              name, "facet loop has " + std::to_string(n) + " vertices; a facet needs at least 3",
-              line);
-        corners.clear();
-        for (std::size_t i = loop_start; i < soup.points.size(); ++i)
-          corners.push_back(static_cast<std::uint32_t>(i));
-        soup.add_polygon(corners.data(), corners.size());
-        state = State::LoopDone;
-      } else {
-        unexpected(key, "'vertex' or 'endloop'", line);
-      }
-      break;
-    case State::LoopDone:
-      if (iequals(key, "endfacet")) {
-        state = State::Solid;
-      } else {
-        unexpected(key, "'endfacet'", line);
-      }
-      break;
-    }
-    if (soup.points.size() >= std::numeric_limits<std::uint32_t>::max())
-      throw IoError(name, "too many vertices", line);
+    if (!key.empty()) parser.take(key, rest, lines.line());
   }
-  if (state != State::Outside)
-    throw IoError(
-        name,
-        "the file ends inside a " + std::string(state == State::Solid ? "solid" : "facet") +
-            " (truncated: no 'endsolid' after " + std::to_string(soup.num_polygons()) + " facets)",
-        lines.line());
+  parser.finish(lines.line());
   if (soup.num_polygons() == 0)
     throw IoError(name, "no faces: the ascii STL has no facets (an empty mesh cannot be loaded)");
   result.info.vertices_in_file = soup.points.size();
