@@ -754,6 +754,17 @@ TEST(IoStl, AsciiSeveralSolidsAndPolygonLoops) {
   EXPECT_EQ(polygon(r.soup, 1), (Poly{3, 4, 5, 6}));
 }
 
+// Text editors on Windows start a file with a UTF-8 byte-order mark; every text reader skips it.
+TEST(IoStl, AsciiWithAByteOrderMark) {
+  const std::string facet = "solid s\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\n"
+                            "vertex 0 1 0\nendloop\nendfacet\nendsolid s\n";
+  for (const std::string& bytes : {"\xEF\xBB\xBF" + facet, "\xEF\xBB\xBF\n  " + facet}) {
+    const SoupFile r = remora::read_soup_from_memory(bytes, MeshFormat::Stl, "bom.stl");
+    EXPECT_EQ(r.info.encoding, "ascii");
+    EXPECT_EQ(r.soup.num_polygons(), 1u);
+  }
+}
+
 TEST(IoStl, Errors) {
   TempDir dir;
   const std::array<float, 9> tri{0, 0, 0, 1, 0, 0, 0, 1, 0};

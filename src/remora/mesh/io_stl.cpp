@@ -175,6 +175,7 @@ private:
 
 SoupFile read_ascii_stl(std::string_view bytes, const std::string& name) {
   check_text(bytes, name);
+  if (bytes.starts_with("\xEF\xBB\xBF")) bytes.remove_prefix(3); // UTF-8 byte-order mark
   SoupFile result;
   result.info.format = "stl";
   result.info.encoding = "ascii";
