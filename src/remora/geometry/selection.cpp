@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "remora/common/error.h"
+#include "remora/geometry/geodesic.h"
 
 namespace remora {
 namespace {
@@ -108,10 +109,8 @@ VertexHandle central_vertex(const Mesh& mesh) {
 }
 
 std::vector<int> select_geodesic_disc(const Mesh& mesh, VertexHandle seed, double radius) {
-  if (!(radius >= 0.0) || std::isnan(radius))
-    throw InvalidArgument(fmt::format("geodesic selection: the radius {} must be >= 0", radius));
-  std::vector<int> out =
-      geodesic_order(mesh, seed, std::numeric_limits<std::size_t>::max(), radius);
+  std::vector<int> out;
+  for (const auto& [v, d] : geodesic_ball(mesh, seed, radius)) out.push_back(v);
   std::sort(out.begin(), out.end());
   return out;
 }

@@ -34,7 +34,9 @@ VertexHandle nearest_vertex(const Mesh& mesh, const Vec3& point);
 /// The vertex nearest to the mean of all vertices: the benchmarks' seed for geodesic supports.
 VertexHandle central_vertex(const Mesh& mesh);
 
-/// geodesic_order(mesh, seed, all, radius), sorted by index: a geodesic disc around `seed`.
+/// The vertices within geodesic distance `radius` of `seed` (fast marching through the triangles,
+/// geometry/geodesic.h: round on a regular grid, where edge paths give a diamond), sorted by
+/// index. Throws InvalidArgument for an invalid seed or a negative or non-finite radius.
 std::vector<int> select_geodesic_disc(const Mesh& mesh, VertexHandle seed, double radius);
 
 } // namespace remora

@@ -1,0 +1,156 @@
+#include "remora/geometry/geodesic.h"
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <queue>
+
+#include <fmt/format.h>
+
+#include "remora/common/error.h"
+
+namespace remora {
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+constexpr std::uint8_t kFar = 0, kTrial = 1, kAccepted = 2;
+
+/// The distance at c of triangle (a, b, c) from the distances da at a and db at b: the triangle
+/// unfolded into the plane, a virtual source on the far side of ab at distances da and db, and the
+/// straight line from it to c if that line crosses ab; otherwise the shorter edge path.
+double through_triangle(const Vec3& a, const Vec3& b, const Vec3& c, double da, double db) {
+  const double ab = (b - a).norm(), ac = (c - a).norm(), bc = (c - b).norm();
+  const double edge_path = std::min(da + ac, db + bc);
+  if (!(ab > 0.0)) return edge_path;
+  // a at the origin, b on the positive x axis, c above it.
+  const double cx = (ac * ac - bc * bc + ab * ab) / (2.0 * ab);
+  const double cy2 = ac * ac - cx * cx;
+  if (!(cy2 > 0.0)) return edge_path;
+  const double cy = std::sqrt(cy2);
+  const double sx = (da * da - db * db + ab * ab) / (2.0 * ab);
+  const double sy2 = da * da - sx * sx;
+  if (sy2 < 0.0) return edge_path; // da, db and ab violate the triangle inequality
+  const double sy = -std::sqrt(sy2);
+  const double t = -sy / (cy - sy); // where the line from s to c meets the x axis
+  const double x = sx + t * (cx - sx);
+  if (x < 0.0 || x > ab) return edge_path;
+  return std::min(edge_path, std::hypot(cx - sx, cy - sy));
+}
+
+void check_radius(double radius) {
+  if (!(radius >= 0.0) || !std::isfinite(radius))
+    throw InvalidArgument(
+        fmt::format("geodesic ball: the radius {} must be finite and >= 0", radius));
+}
+
+} // namespace
+
+FastMarching::FastMarching(const Mesh& mesh)
+    : faces_(mesh.n_faces()), ring_begin_(mesh.n_vertices() + 1, 0),
+      distance_(mesh.n_vertices(), kInf), state_(mesh.n_vertices(), kFar) {
+  for (const FaceHandle f : mesh.faces())
+    for (const VertexHandle v : face_vertices(mesh, f)) ++ring_begin_[v.idx() + 1];
+  for (std::size_t v = 0; v < mesh.n_vertices(); ++v) ring_begin_[v + 1] += ring_begin_[v];
+  ring_.resize(ring_begin_.back());
+  std::vector<std::uint32_t> fill(ring_begin_.begin(), ring_begin_.end() - 1);
+  for (const FaceHandle f : mesh.faces()) {
+    const auto c = face_vertices(mesh, f);
+    for (std::size_t k = 0; k < 3; ++k)
+      ring_[fill[static_cast<std::size_t>(c[k].idx())]++] = {c[(k + 1) % 3].idx(),
+                                                             c[(k + 2) % 3].idx()};
+  }
+}
+
+std::vector<std::pair<int, double>>
+FastMarching::march(const Mesh& mesh, const std::vector<std::pair<int, double>>& seeds,
+                    double radius) {
+  if (mesh.n_vertices() != distance_.size() || mesh.n_faces() != faces_)
+    throw InvalidArgument(fmt::format(
+        "geodesic ball: the mesh has {} vertices and {} faces; the marcher was built for {} and {}",
+        mesh.n_vertices(), mesh.n_faces(), distance_.size(), faces_));
+  for (const int v : touched_) {
+    distance_[static_cast<std::size_t>(v)] = kInf;
+    state_[static_cast<std::size_t>(v)] = kFar;
+  }
+  touched_.clear();
+  const Vec3* points = mesh.points();
+  using Item = std::pair<double, int>;
+  std::priority_queue<Item, std::vector<Item>, std::greater<>> front;
+  auto offer = [&](int v, double d) {
+    const auto i = static_cast<std::size_t>(v);
+    if (!(d < distance_[i])) return;
+    if (state_[i] == kFar) {
+      state_[i] = kTrial;
+      touched_.push_back(v);
+    }
+    distance_[i] = d;
+    front.push({d, v});
+  };
+  for (const auto& [v, d] : seeds) offer(v, d);
+  std::vector<std::pair<int, double>> out;
+  while (!front.empty()) {
+    const auto [d, v] = front.top();
+    front.pop();
+    const auto i = static_cast<std::size_t>(v);
+    if (state_[i] == kAccepted || d > distance_[i]) continue; // a stale entry
+    if (d > radius) break;
+    state_[i] = kAccepted;
+    out.emplace_back(v, d);
+    const Vec3& pv = points[i];
+    for (std::uint32_t r = ring_begin_[i]; r < ring_begin_[i + 1]; ++r)
+      for (int side = 0; side < 2; ++side) {
+        const auto x = static_cast<std::size_t>(ring_[r][static_cast<std::size_t>(side)]);
+        const auto y = static_cast<std::size_t>(ring_[r][static_cast<std::size_t>(1 - side)]);
+        if (state_[y] == kAccepted) continue;
+        double candidate = d + (points[y] - pv).norm();
+        if (state_[x] == kAccepted)
+          candidate =
+              std::min(candidate, through_triangle(pv, points[x], points[y], d, distance_[x]));
+        offer(static_cast<int>(y), candidate);
+      }
+  }
+  return out;
+}
+
+std::vector<std::pair<int, double>> FastMarching::ball(const Mesh& mesh, const SurfacePoint& source,
+                                                       double radius) {
+  check_radius(radius);
+  const FaceHandle f = source.face;
+  if (!f.is_valid() || f.idx() >= static_cast<int>(mesh.n_faces()) || mesh.status(f).deleted())
+    throw InvalidArgument(
+        fmt::format("geodesic ball: face {} is not a face of the mesh (it has {} faces)", f.idx(),
+                    mesh.n_faces()));
+  for (const double b : source.bary)
+    if (!std::isfinite(b))
+      throw InvalidArgument("geodesic ball: the source's barycentric coordinates are not finite");
+  const Vec3 point = evaluate(mesh, source);
+  std::vector<std::pair<int, double>> seeds;
+  for (const VertexHandle v : face_vertices(mesh, f))
+    seeds.emplace_back(v.idx(), (mesh.point(v) - point).norm());
+  return march(mesh, seeds, radius);
+}
+
+std::vector<std::pair<int, double>> FastMarching::ball(const Mesh& mesh, VertexHandle source,
+                                                       double radius) {
+  check_radius(radius);
+  if (!source.is_valid() || source.idx() >= static_cast<int>(mesh.n_vertices()) ||
+      mesh.status(source).deleted())
+    throw InvalidArgument(
+        fmt::format("geodesic ball: vertex {} is not a vertex of the mesh (it has {} vertices)",
+                    source.idx(), mesh.n_vertices()));
+  return march(mesh, {{source.idx(), 0.0}}, radius);
+}
+
+std::vector<std::pair<int, double>> geodesic_ball(const Mesh& mesh, const SurfacePoint& source,
+                                                  double radius) {
+  return FastMarching(mesh).ball(mesh, source, radius);
+}
+
+std::vector<std::pair<int, double>> geodesic_ball(const Mesh& mesh, VertexHandle source,
+                                                  double radius) {
+  return FastMarching(mesh).ball(mesh, source, radius);
+}
+
+} // namespace remora

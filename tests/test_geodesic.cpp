@@ -1,0 +1,136 @@
+// Geodesic distance by fast marching (geometry/geodesic.h): against the analytic distances of a
+// plane and a sphere, against edge paths (which give diamonds), and its contract.
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include <gtest/gtest.h>
+
+#include "remora/common/error.h"
+#include "remora/geometry/geodesic.h"
+#include "remora/geometry/selection.h"
+#include "remora/mesh/primitives.h"
+
+namespace remora {
+namespace {
+
+/// The largest |d - exact| / exact over the ball's vertices farther than `from` from the source.
+template <class Exact>
+double worst_relative_error(const std::vector<std::pair<int, double>>& ball, double from,
+                            Exact exact) {
+  double worst = 0.0;
+  for (const auto& [v, d] : ball) {
+    const double e = exact(v);
+    if (e > from) worst = std::max(worst, std::abs(d - e) / e);
+  }
+  return worst;
+}
+
+TEST(Geodesic, IsTheStraightDistanceOnAPlaneAndNotTheEdgePath) {
+  // A 60 x 60 square grid of right triangles: the edge paths along the diagonals that the split
+  // does not follow are sqrt(2) times too long.
+  const Mesh grid = make_grid(60, 60, 1.0, 1.0);
+  const VertexHandle centre(30 * 61 + 30);
+  const Vec3 c = grid.point(centre);
+  const double r = 0.4;
+  const auto ball = geodesic_ball(grid, centre, r);
+  const auto euclid = [&](int v) { return (grid.point(VertexHandle(v)) - c).norm(); };
+  EXPECT_LT(worst_relative_error(ball, 3.0 / 60, euclid), 0.02);
+  // In increasing order of distance, none beyond the radius.
+  for (std::size_t i = 1; i < ball.size(); ++i) EXPECT_LE(ball[i - 1].second, ball[i].second);
+  EXPECT_LE(ball.back().second, r);
+  // The ball is the disc: every vertex well inside it is in, every vertex in it is near it.
+  const auto disc = select_geodesic_disc(grid, centre, r);
+  const auto sphere_inner = select_sphere(grid, c, r * 0.97);
+  EXPECT_TRUE(std::includes(disc.begin(), disc.end(), sphere_inner.begin(), sphere_inner.end()));
+  for (const int v : disc) EXPECT_LE(euclid(v), r * 1.001);
+  // Edge paths (geodesic_order) miss much of that disc: the diamond a brush must not paint.
+  auto edge_ball = geodesic_order(grid, centre, grid.n_vertices(), r);
+  std::sort(edge_ball.begin(), edge_ball.end());
+  EXPECT_LT(static_cast<double>(edge_ball.size()), 0.95 * static_cast<double>(disc.size()));
+  EXPECT_FALSE(
+      std::includes(edge_ball.begin(), edge_ball.end(), sphere_inner.begin(), sphere_inner.end()));
+}
+
+TEST(Geodesic, ConvergesToTheGreatCircleDistanceOnASphere) {
+  double previous = 1.0;
+  for (const int s : {4, 5, 6}) {
+    const Mesh sphere = make_icosphere(s, 1.0);
+    const VertexHandle source(0);
+    const Vec3 p = sphere.point(source);
+    const auto arc = [&](int v) {
+      const double cosine = OpenMesh::dot(sphere.point(VertexHandle(v)), p);
+      return std::acos(std::clamp(cosine, -1.0, 1.0));
+    };
+    const auto ball = geodesic_ball(sphere, source, 1.5);
+    const double error = worst_relative_error(ball, 0.2, arc);
+    EXPECT_LT(error, 0.03) << "subdivisions " << s;
+    EXPECT_LT(error, previous) << "subdivisions " << s;
+    previous = error;
+    // Never shorter than the chord (up to the march's small error).
+    for (const auto& [v, d] : ball)
+      EXPECT_GE(d, 0.99 * (sphere.point(VertexHandle(v)) - p).norm() - 1e-12);
+  }
+}
+
+TEST(Geodesic, FromAPointInAFace) {
+  const Mesh grid = make_grid(40, 40, 1.0, 1.0);
+  // The first face of the quad whose lower left corner is (20, 20), at its centroid.
+  const FaceHandle f(2 * (20 * 40 + 20));
+  const SurfacePoint source{f, {1.0 / 3, 1.0 / 3, 1.0 / 3}};
+  const Vec3 c = evaluate(grid, source);
+  const auto ball = geodesic_ball(grid, source, 0.3);
+  const auto euclid = [&](int v) { return (grid.point(VertexHandle(v)) - c).norm(); };
+  // The face's corners are at their exact distance; the rest within the plane's error.
+  for (const VertexHandle v : face_vertices(grid, f)) {
+    const auto it = std::find_if(ball.begin(), ball.end(),
+                                 [&](const auto& item) { return item.first == v.idx(); });
+    ASSERT_NE(it, ball.end());
+    EXPECT_DOUBLE_EQ(it->second, euclid(v.idx()));
+  }
+  EXPECT_LT(worst_relative_error(ball, 3.0 / 40, euclid), 0.02);
+  // Radius 0: nothing, as a brush of radius 0 paints nothing.
+  EXPECT_TRUE(geodesic_ball(grid, source, 0.0).empty());
+}
+
+TEST(Geodesic, OneMarcherGivesTheSameBallsAsFreshOnesAndFollowsMovedVertices) {
+  Mesh sphere = make_icosphere(4, 1.0);
+  FastMarching marching(sphere);
+  for (const int v : {0, 17, 300, 17})
+    EXPECT_EQ(marching.ball(sphere, VertexHandle(v), 0.7),
+              geodesic_ball(sphere, VertexHandle(v), 0.7))
+        << "source " << v;
+  // Scaled by 2: every distance doubles.
+  const auto before = marching.ball(sphere, VertexHandle(5), 0.5);
+  for (const VertexHandle v : sphere.vertices()) sphere.set_point(v, 2.0 * sphere.point(v));
+  const auto after = marching.ball(sphere, VertexHandle(5), 1.0);
+  ASSERT_EQ(before.size(), after.size());
+  for (std::size_t i = 0; i < before.size(); ++i)
+    EXPECT_NEAR(after[i].second, 2.0 * before[i].second, 1e-12);
+  EXPECT_THROW(marching.ball(make_icosphere(2, 1.0), VertexHandle(0), 1.0), InvalidArgument);
+  // Two spheres in one mesh: a ball larger than either reaches one sphere only.
+  Mesh two = make_icosphere(2, 1.0);
+  const Mesh other = make_icosphere(2, 1.0);
+  std::vector<VertexHandle> added;
+  for (const VertexHandle v : other.vertices())
+    added.push_back(two.add_vertex(other.point(v) + Vec3(5, 0, 0)));
+  for (const FaceHandle f : other.faces()) {
+    std::vector<VertexHandle> corners;
+    for (const VertexHandle v : other.fv_range(f)) corners.push_back(added[v.idx()]);
+    two.add_face(corners);
+  }
+  EXPECT_EQ(geodesic_ball(two, VertexHandle(0), 100.0).size(), other.n_vertices());
+}
+
+TEST(Geodesic, RefusesBadArguments) {
+  const Mesh grid = make_grid(4, 4, 1.0, 1.0);
+  EXPECT_THROW(geodesic_ball(grid, VertexHandle(100), 1.0), InvalidArgument);
+  EXPECT_THROW(geodesic_ball(grid, VertexHandle(0), -1.0), InvalidArgument);
+  EXPECT_THROW(geodesic_ball(grid, VertexHandle(0), std::nan("")), InvalidArgument);
+  EXPECT_THROW(geodesic_ball(grid, SurfacePoint{FaceHandle(99), {1, 0, 0}}, 1.0), InvalidArgument);
+  EXPECT_THROW(geodesic_ball(grid, SurfacePoint{FaceHandle(0), {std::nan(""), 0, 0}}, 1.0),
+               InvalidArgument);
+}
+
+} // namespace
+} // namespace remora
