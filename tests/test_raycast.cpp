@@ -110,6 +110,37 @@ TEST(RayCaster, ALargeMeshsTreeAgreesToo) {
   }
 }
 
+// The editor's page picks on the edited shape: a tree refitted after the vertices moved answers
+// as a search over the moved faces, and the stale tree does not.
+TEST(RayCaster, ARefittedTreeAgreesWithTheMovedMesh) {
+  Mesh mesh = two_shells();
+  RayCaster caster(mesh);
+  // Twist about z by up to 60 degrees and stretch along x: every face moves.
+  for (const VertexHandle v : mesh.vertices()) {
+    const Vec3 p = mesh.point(v);
+    const double a = 0.5 * p[2] + 0.3, c = std::cos(a), s = std::sin(a);
+    mesh.set_point(v, Vec3(1.5 * (c * p[0] - s * p[1]), s * p[0] + c * p[1], p[2]));
+  }
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> u(-1.5, 1.5), in(-0.5, 0.5);
+  int stale_wrong = 0;
+  for (int i = 0; i < 500; ++i) {
+    const Vec3 o(in(rng), in(rng), in(rng)), d(u(rng), u(rng), u(rng));
+    const double expected = brute_force(mesh, o, d, 0.0, kInf);
+    const RayHit stale = caster.first_hit(o, d, 0.0, kInf);
+    stale_wrong += !stale.face.is_valid() || std::abs(stale.t - expected) > 1e-6;
+  }
+  EXPECT_GT(stale_wrong, 100);
+  caster.refit(mesh);
+  for (int i = 0; i < 1000; ++i) {
+    const Vec3 o(in(rng), in(rng), in(rng)), d(u(rng), u(rng), u(rng));
+    const RayHit hit = caster.first_hit(o, d, 0.0, kInf);
+    ASSERT_TRUE(hit.face.is_valid()) << "ray " << i;
+    EXPECT_NEAR(hit.t, brute_force(mesh, o, d, 0.0, kInf), 1e-9) << "ray " << i;
+  }
+  EXPECT_THROW(caster.refit(make_icosphere(1, 1.0)), InvalidArgument);
+}
+
 TEST(RayCaster, FromAVertexSkipsItsOwnFacesAndMeetsTheFarSide) {
   const Mesh cube = make_cube(3, 2.0);
   const RayCaster caster(cube);

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cassert>
 #include <cmath>
+#include <cstddef>
 
 #include <fmt/format.h>
 
@@ -134,6 +135,47 @@ RayCaster::RayCaster(const Mesh& mesh) {
   sorted.reserve(faces_.size());
   for (const std::int32_t i : order) sorted.push_back(faces_[static_cast<std::size_t>(i)]);
   faces_ = std::move(sorted);
+}
+
+void RayCaster::refit(const Mesh& mesh) {
+  if (mesh.n_vertices() != points_.size())
+    throw InvalidArgument(fmt::format("ray caster: refit with {} vertices; the tree has {}",
+                                      mesh.n_vertices(), points_.size()));
+  for (const VertexHandle v : mesh.vertices()) {
+    const Vec3& p = mesh.point(v);
+    if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
+      throw InvalidArgument(
+          fmt::format("ray caster: vertex {} is not finite; repair the mesh first", v.idx()));
+    points_[static_cast<std::size_t>(v.idx())] = p;
+  }
+  // Children come after their parent: from the last node back, every child is done first.
+  for (auto i = static_cast<std::ptrdiff_t>(nodes_.size()) - 1; i >= 0; --i) {
+    Node& n = nodes_[static_cast<std::size_t>(i)];
+    if (n.count == 0) {
+      const Node& l = nodes_[static_cast<std::size_t>(i) + 1];
+      const Node& r = nodes_[static_cast<std::size_t>(n.first)];
+      for (int k = 0; k < 3; ++k) {
+        n.lo[k] = std::min(l.lo[k], r.lo[k]);
+        n.hi[k] = std::max(l.hi[k], r.hi[k]);
+      }
+      continue;
+    }
+    double lo[3], hi[3];
+    for (int k = 0; k < 3; ++k) {
+      lo[k] = std::numeric_limits<double>::infinity();
+      hi[k] = -std::numeric_limits<double>::infinity();
+    }
+    for (std::int32_t f = n.first; f < n.first + n.count; ++f)
+      for (const std::int32_t v : faces_[static_cast<std::size_t>(f)].v)
+        for (int k = 0; k < 3; ++k) {
+          lo[k] = std::min(lo[k], points_[static_cast<std::size_t>(v)][k]);
+          hi[k] = std::max(hi[k], points_[static_cast<std::size_t>(v)][k]);
+        }
+    for (int k = 0; k < 3; ++k) {
+      n.lo[k] = down(lo[k]);
+      n.hi[k] = up(hi[k]);
+    }
+  }
 }
 
 // Appends to `nodes` the subtree over order[begin, end) (indices into faces_ and centroids):

@@ -37,6 +37,13 @@ public:
   RayHit first_hit(const Vec3& origin, const Vec3& direction, double t_min, double t_max,
                    VertexHandle skip = VertexHandle()) const;
 
+  /// Takes the corners of the same faces from `mesh` after its vertices moved (the editor's page
+  /// picks on the edited shape): the bounds are recomputed, the tree's shape is kept, so queries
+  /// stay exact and slow down only after large motions. O(faces), much cheaper than a rebuild.
+  /// The faces left out at construction (zero area) stay out. Throws InvalidArgument if `mesh`
+  /// has another number of vertices or a corner that is not finite.
+  void refit(const Mesh& mesh);
+
   std::size_t n_faces() const { return faces_.size(); }
 
 private:
