@@ -6,6 +6,7 @@
 #include <utility>
 
 #include <Eigen/Geometry>
+#include <Eigen/SVD>
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
@@ -508,6 +509,15 @@ void Editor::set_transform(int handle, const Transform& transform) {
   if (!transform.allFinite())
     throw InvalidArgument(
         fmt::format("the transform of handle {} has a NaN or infinite entry", handle));
+  // A mirror (det M < 0) turns the patch inside out; a collapse (a singular value near 0)
+  // crumples it: neither is an edit a user means.
+  const Eigen::Matrix3d m = transform.leftCols<3>();
+  const Eigen::Vector3d singular = Eigen::JacobiSVD<Eigen::Matrix3d>(m).singularValues();
+  if (!(m.determinant() > 0.0) || !(singular[2] > 1e-6 * singular[0]))
+    throw InvalidArgument(fmt::format(
+        "the transform of handle {} {} the handle (det M = {:.3g}): scale by a positive factor "
+        "on every axis",
+        handle, m.determinant() < 0.0 ? "mirrors" : "collapses", m.determinant()));
   r.transforms[static_cast<std::size_t>(handle)] = transform;
   r.dirty = true;
 }

@@ -144,7 +144,9 @@ public:
   Eigen::Vector3d handle_center(int handle) const;
 
   /// Step 6: handle j's vertices go to T [x; 1] of their rest positions. Throws InvalidArgument
-  /// for j out of range or a non-finite T. Cheap: the work happens in positions().
+  /// for j out of range, a non-finite T, or a linear part M that mirrors (det M <= 0) or
+  /// collapses (a singular value below 1e-6 of the largest) the handle. Cheap: the work happens
+  /// in positions().
   void set_transform(int handle, const Transform& transform);
   const Transform& transform(int handle) const;
 
