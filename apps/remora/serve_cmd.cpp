@@ -10,6 +10,7 @@
 
 #include "api.h"
 #include "commands.h"
+#include "http.h"
 #include "remora/common/error.h"
 #include "session.h"
 
@@ -64,25 +65,7 @@ void add_serve_command(CLI::App& app) {
       session.start_load(bytes.str(), std::filesystem::path(a->mesh).filename().string());
     }
     httplib::Server http;
-    http.set_payload_max_length(limits.max_upload_bytes + 1);
-    const std::string root = a->web_root;
-    auto adapt = [&session, &limits, root](const httplib::Request& req, httplib::Response& res) {
-      server::HttpRequest q{req.method, req.path, {}, req.body};
-      for (const auto& [key, value] : req.params) q.query[key] = value;
-      server::HttpResponse r;
-      if (req.path.rfind("/api/", 0) == 0)
-        r = server::handle_api(session, q, limits);
-      else if (req.method == "GET")
-        r = server::serve_static(root, req.path);
-      else
-        r = {405, "application/json", R"({"error": "only GET serves files"})", {}};
-      res.status = r.status;
-      for (const auto& [key, value] : r.headers) res.set_header(key, value);
-      res.set_header("Cache-Control", "no-store");
-      res.set_content(r.body, r.content_type.c_str());
-    };
-    http.Get(".*", adapt);
-    http.Post(".*", adapt);
+    server::bind_http(http, session, limits, a->web_root);
     int port = a->port;
     if (port == 0) {
       port = http.bind_to_any_port(a->host.c_str());

@@ -1,5 +1,6 @@
 #include "api.h"
 
+#include <cctype>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -60,7 +61,7 @@ json parse_json(const HttpRequest& request, const ApiLimits& limits) {
                                  limits.max_json_bytes));
   try {
     return json::parse(request.body);
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) { // a syntax error, or a number out of range (1e400)
     throw BadRequest(fmt::format("the body is not valid JSON: {}", e.what()));
   }
 }
@@ -131,6 +132,55 @@ HttpResponse transform(Session& session, const HttpRequest& request, const ApiLi
   return r;
 }
 
+/// A 3-vector of finite numbers at `key`.
+Vec3 vec3(const json& j, const char* key) {
+  const json& v = j.contains(key) ? j.at(key) : json();
+  if (!v.is_array() || v.size() != 3)
+    throw BadRequest(fmt::format("{}: expected 3 numbers [x, y, z]", key));
+  Vec3 out;
+  for (std::size_t c = 0; c < 3; ++c) {
+    if (!v[c].is_number() || !std::isfinite(v[c].get<double>()))
+      throw BadRequest(fmt::format("{}[{}]: expected a finite number", key, c));
+    out[static_cast<int>(c)] = v[c].get<double>();
+  }
+  return out;
+}
+
+HttpResponse pick(Session& session, const HttpRequest& request, const ApiLimits& limits) {
+  const json j = parse_json(request, limits);
+  only_keys(j, {"origin", "direction", "radius", "brush"});
+  const Vec3 origin = vec3(j, "origin"), direction = vec3(j, "direction");
+  if (!(direction.sqrnorm() > 0.0)) throw BadRequest("direction: must not be zero");
+  double radius = 0.0;
+  if (j.contains("radius")) {
+    if (!j.at("radius").is_number() || !(j.at("radius").get<double>() >= 0.0) ||
+        !std::isfinite(j.at("radius").get<double>()))
+      throw BadRequest("radius: expected a finite number >= 0");
+    radius = j.at("radius").get<double>();
+  }
+  Brush brush = Brush::Geodesic;
+  if (j.contains("brush")) {
+    if (!j.at("brush").is_string()) throw BadRequest("brush: expected \"geodesic\" or \"sphere\"");
+    brush = parse_brush(j.at("brush").get<std::string>());
+  }
+  const Pick p = session.pick(origin, direction, radius, brush);
+  HttpResponse r = binary_response(p.brush);
+  r.headers["X-Hit-Face"] = std::to_string(p.face);
+  r.headers["X-Hit-Vertex"] = std::to_string(p.vertex);
+  r.headers["X-Hit-Point"] =
+      fmt::format("{:.9g} {:.9g} {:.9g}", p.point[0], p.point[1], p.point[2]);
+  return r;
+}
+
+/// The download's file name: the loaded file's stem, "_edited" and the format's extension.
+std::string export_name(const std::string& loaded, const std::string& format) {
+  std::string stem = std::filesystem::path(loaded).stem().string();
+  // Only characters that need no quoting in a header.
+  for (char& c : stem)
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_' && c != '.') c = '_';
+  return (stem.empty() ? std::string("mesh") : stem) + "_edited." + format;
+}
+
 HttpResponse dispatch(Session& session, const HttpRequest& q, const ApiLimits& limits) {
   const std::string& p = q.path;
   const bool get = q.method == "GET";
@@ -162,6 +212,7 @@ HttpResponse dispatch(Session& session, const HttpRequest& q, const ApiLimits& l
   if (p == "/api/region" && get) return json_response(200, session.region());
   if (p == "/api/region") return need("POST", "GET, POST"), region(session, q, limits);
   if (p == "/api/transform") return post_only(), transform(session, q, limits);
+  if (p == "/api/pick") return post_only(), pick(session, q, limits);
   if (p == "/api/commit")
     return post_only(), session.commit(), json_response(200, session.status());
   if (p == "/api/undo" || p == "/api/redo") {
@@ -178,7 +229,8 @@ HttpResponse dispatch(Session& session, const HttpRequest& q, const ApiLimits& l
     HttpResponse r;
     r.content_type = "application/octet-stream";
     r.body = session.export_mesh(format);
-    r.headers["Content-Disposition"] = fmt::format("attachment; filename=\"edited.{}\"", format);
+    r.headers["Content-Disposition"] =
+        fmt::format("attachment; filename=\"{}\"", export_name(session.name(), format));
     return r;
   }
   return error_response(404, fmt::format("no endpoint {} (see docs/server.md)", p));

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <functional>
+#include <string_view>
+#include <utility>
 
 #include <fmt/format.h>
 
@@ -42,6 +44,18 @@ bool is_identity(const std::vector<Transform>& transforms) {
   return true;
 }
 
+/// Where a phase of the editor's preprocessing sits in the whole of it, as [begin, end)
+/// fractions: shares of the wall time of the bundled bunny's and igea_sub4's preprocessing, an
+/// estimate for other meshes (the bar moves on, it does not promise a time).
+std::pair<double, double> preprocess_share(std::string_view phase) {
+  if (phase == "reading") return {0.0, 0.05};
+  if (phase == "base surface") return {0.05, 0.2};
+  if (phase == "remesh: remesh") return {0.2, 0.6};
+  if (phase == "remesh: equalize") return {0.6, 0.9};
+  if (phase == "remesh: correspondence") return {0.9, 0.97};
+  return {0.97, 1.0};
+}
+
 } // namespace
 
 struct Session::Impl {
@@ -53,14 +67,20 @@ struct Session::Impl {
   std::string job;   // what the worker does ("load", "region")
   std::string phase; // its current phase
   int step = 0, steps = 0;
-  std::string error;                 // the last job's failure, if any
-  std::string name;                  // the mesh's file name
-  std::shared_ptr<EditorBox> box;    // current editor
-  std::optional<RegionKey> region;   // current region
-  std::vector<Transform> transforms; // live transforms
+  double fraction = 0.0;                   // of the whole job
+  double span_begin = 0.0, span_end = 1.0; // the share of the job preprocessing takes
+  std::string error;                       // the last job's failure, if any
+  std::string name;                        // the mesh's file name
+  std::shared_ptr<EditorBox> box;          // current editor
+  std::optional<RegionKey> region;         // current region
+  std::vector<Transform> transforms;       // live transforms
   std::vector<Snapshot> history;
   std::size_t cursor = 0; // history[cursor] is the applied snapshot
   double last_frame_ms = 0.0;
+  std::shared_ptr<Shape> shape; // what the page shows and paints on
+  // Change counters (status): the faces (a load), the positions other than through a frame of
+  // set_transform (load, undo, redo, a new k under moved handles), the region.
+  std::uint64_t mesh_id = 0, positions_id = 0, region_id = 0;
 
   void require_ready() const {
     if (busy) throw Busy(fmt::format("the session is busy ({}: {})", job, phase));
@@ -89,6 +109,7 @@ struct Session::Impl {
   }
   /// Re-applies a snapshot (undo/redo): same editor, region and transforms, same positions.
   void apply(const Snapshot& s) {
+    if (s.box != box || s.region != region) ++region_id;
     box = s.box;
     region = s.region;
     transforms = s.transforms;
@@ -99,6 +120,22 @@ struct Session::Impl {
     }
     for (std::size_t j = 0; j < transforms.size(); ++j)
       box->editor.set_transform(static_cast<int>(j), transforms[j]);
+    shape->set_positions(region ? box->editor.positions() : positions_matrix(box->editor.input()));
+    ++positions_id;
+  }
+  /// The job's progress: `phase` at `s` of `n` steps; its fraction of the whole job from the
+  /// preprocessing shares. Call under the lock.
+  void report(std::string_view p, int s, int n) {
+    phase = std::string(p);
+    step = s;
+    steps = n;
+    if (p == "set_region") { // the rest of a region job: [span_end, 1]
+      fraction = span_end;
+      return;
+    }
+    const auto [begin, end] = preprocess_share(p);
+    const double within = n > 0 ? std::clamp(double(s) / n, 0.0, 1.0) : 0.0;
+    fraction = span_begin + (span_end - span_begin) * (begin + (end - begin) * within);
   }
   void run(std::string what, std::function<void()> work) {
     if (busy) throw Busy(fmt::format("the session is busy ({}: {})", job, phase));
@@ -107,6 +144,7 @@ struct Session::Impl {
     job = std::move(what);
     phase = "starting";
     step = steps = 0;
+    fraction = 0.0;
     error.clear();
     worker = std::thread([this, work = std::move(work)] {
       try {
@@ -126,9 +164,7 @@ struct Session::Impl {
     o.threads = options.threads;
     o.progress = [this](std::string_view p, int s, int n) {
       std::lock_guard lock(mutex);
-      phase = std::string(p);
-      step = s;
-      steps = n;
+      report(p, s, n);
     };
     return o;
   }
@@ -155,13 +191,20 @@ void Session::start_load(std::string bytes, std::string name) {
     const auto t0 = Clock::now();
     {
       std::lock_guard guard(m.mutex);
-      m.phase = "reading";
+      m.span_begin = 0.0;
+      m.span_end = 1.0;
+      m.report("reading", 0, 1);
     }
     LoadResult loaded = read_mesh_from_memory(bytes, format, name);
+    auto shape = std::make_shared<Shape>(loaded.mesh);
     auto box = std::make_shared<EditorBox>(Editor(std::move(loaded.mesh), m.editor_options()));
     box->preprocess_ms = ms_since(t0);
     std::lock_guard guard(m.mutex);
     m.box = box;
+    m.shape = std::move(shape);
+    ++m.mesh_id;
+    ++m.positions_id;
+    ++m.region_id;
     m.name = name;
     m.region.reset();
     m.transforms.clear();
@@ -188,32 +231,50 @@ void Session::start_region(std::vector<int> support, std::vector<std::vector<int
                                           "vertices)",
                                           v, n));
   RegionKey key{std::move(support), std::move(handles), k};
-  const bool bake = !is_identity(m.transforms);
-  std::shared_ptr<EditorBox> current = m.box;
-  m.run("region", [this, key = std::move(key), bake, current] {
-    Impl& s = *impl_;
-    std::shared_ptr<EditorBox> box = current;
-    if (bake) {
-      // The edited shape becomes the next input: a new base, remeshed.
-      const auto t0 = Clock::now();
-      Mesh result = current->editor.result();
-      box = std::make_shared<EditorBox>(Editor(std::move(result), s.editor_options()));
-      box->preprocess_ms = ms_since(t0);
-    }
-    {
-      std::lock_guard guard(s.mutex);
-      s.phase = "set_region";
-    }
-    // On a copy of the key: a failure leaves the session as it was.
-    box->editor.set_system({key.k, box->editor.options().system.areas});
-    box->editor.set_region(key.support, key.handles);
-    box->region = key;
-    std::lock_guard guard(s.mutex);
-    s.box = box;
-    s.region = key;
-    s.transforms.assign(key.handles.size(), identity_transform());
-    s.push_snapshot();
-  });
+  // Only k changes: the same handles keep their transforms, solved again (no bake), so that a
+  // user compares k on the same drag.
+  const bool new_k = m.region && m.region->support == key.support &&
+                     m.region->handles == key.handles && m.region->k != key.k;
+  const bool bake = !new_k && !is_identity(m.transforms);
+  m.span_begin = 0.0;
+  m.span_end = bake ? 0.85 : 0.0;
+  m.run("region",
+        [this, key = std::move(key), bake, new_k, current = m.box, transforms = m.transforms] {
+          Impl& s = *impl_;
+          std::shared_ptr<EditorBox> box = current;
+          if (bake) {
+            // The edited shape becomes the next input: a new base, remeshed.
+            const auto t0 = Clock::now();
+            Mesh result = current->editor.result();
+            box = std::make_shared<EditorBox>(Editor(std::move(result), s.editor_options()));
+            box->preprocess_ms = ms_since(t0);
+          }
+          {
+            std::lock_guard guard(s.mutex);
+            s.report("set_region", 0, 1);
+          }
+          // On a copy of the key: a failure leaves the session as it was.
+          box->editor.set_system({key.k, box->editor.options().system.areas});
+          box->editor.set_region(key.support, key.handles);
+          box->region = key;
+          std::optional<Eigen::MatrixXd> moved;
+          if (new_k) {
+            for (std::size_t j = 0; j < transforms.size(); ++j)
+              box->editor.set_transform(static_cast<int>(j), transforms[j]);
+            moved = box->editor.positions();
+          }
+          std::lock_guard guard(s.mutex);
+          s.box = box;
+          s.region = key;
+          ++s.region_id;
+          if (moved) {
+            s.shape->set_positions(*moved);
+            ++s.positions_id;
+          } else {
+            s.transforms.assign(key.handles.size(), identity_transform());
+          }
+          s.push_snapshot();
+        });
 }
 
 std::vector<float> Session::set_transform(int handle, const Transform& transform,
@@ -231,6 +292,7 @@ std::vector<float> Session::set_transform(int handle, const Transform& transform
     for (int c = 0; c < 3; ++c)
       out[3 * i + static_cast<std::size_t>(c)] = static_cast<float>(p(movable[i], c));
   m.last_frame_ms = ms_since(t0);
+  m.shape->set_positions(movable, p);
   if (frame_ms) *frame_ms = m.last_frame_ms;
   return out;
 }
@@ -268,7 +330,14 @@ nlohmann::json Session::status() const {
   nlohmann::json j;
   j["state"] = m.busy ? "busy" : (m.box ? "ready" : "empty");
   if (m.busy)
-    j["progress"] = {{"job", m.job}, {"phase", m.phase}, {"step", m.step}, {"steps", m.steps}};
+    j["progress"] = {{"job", m.job},
+                     {"phase", m.phase},
+                     {"step", m.step},
+                     {"steps", m.steps},
+                     {"fraction", m.fraction}};
+  j["mesh_id"] = m.mesh_id;
+  j["positions_id"] = m.positions_id;
+  j["region_id"] = m.region_id;
   if (!m.error.empty()) j["error"] = m.error;
   j["undo"] = !m.busy && m.cursor > 0;
   j["redo"] = !m.busy && m.cursor + 1 < m.history.size();
@@ -379,6 +448,17 @@ std::vector<float> Session::base_areas() const {
   for (Eigen::Index i = 0; i < a.size(); ++i)
     out[static_cast<std::size_t>(i)] = static_cast<float>(a[i] / mean);
   return out;
+}
+
+Pick Session::pick(const Vec3& origin, const Vec3& direction, double radius, Brush brush) {
+  std::lock_guard lock(impl_->mutex);
+  if (!impl_->shape) throw Busy("no mesh is loaded yet: load one first");
+  return impl_->shape->pick(origin, direction, radius, brush);
+}
+
+std::string Session::name() const {
+  std::lock_guard lock(impl_->mutex);
+  return impl_->name;
 }
 
 std::string Session::export_mesh(const std::string& format) const {

@@ -25,6 +25,7 @@
 #include "remora/common/error.h"
 #include "remora/mesh/mesh.h"
 #include "remora/multires/editor.h"
+#include "shape.h"
 
 namespace remora::server {
 
@@ -51,8 +52,10 @@ public:
   /// Starts loading (parse, repair, preprocess) on the worker. `bytes` are a file's content, `name`
   /// its file name (the extension gives the format). Throws Busy while other work runs.
   void start_load(std::string bytes, std::string name);
-  /// Starts a new region on the worker (baking the current result first when a handle moved).
-  /// Validates ids and k first (InvalidArgument). Throws Busy while other work runs.
+  /// Starts a new region on the worker (baking the current result first when a handle moved,
+  /// except when only k changes: then the handles keep their transforms and the new system is
+  /// solved under them). Validates ids and k first (InvalidArgument). Throws Busy while other
+  /// work runs.
   void start_region(std::vector<int> support, std::vector<std::vector<int>> handles, int k);
   /// Blocks until the worker is idle (tests and the CLI).
   void wait();
@@ -65,7 +68,17 @@ public:
   bool undo(); ///< false when there is nothing to undo
   bool redo();
 
+  /// {"state": "empty" | "busy" | "ready", "progress": {job, phase, step, steps, fraction} while
+  /// busy, "error" of the last job, "undo", "redo", the change counters "mesh_id" (a load),
+  /// "positions_id" (positions changed other than by a set_transform frame) and "region_id",
+  /// and when ready the mesh, base, region and transforms (docs/server.md).
   nlohmann::json status() const;
+  /// Picks on the shape shown (the current positions, live transforms included) with a brush;
+  /// works while a region job runs. Throws Busy before the first load, InvalidArgument for a bad
+  /// ray or radius.
+  Pick pick(const Vec3& origin, const Vec3& direction, double radius, Brush brush);
+  /// The loaded file's name ("" before the first load).
+  std::string name() const;
   /// The current region as {"support": [ids], "handles": [[ids], ...], "k": k}, or null.
   nlohmann::json region() const;
   /// Current positions of every vertex (Float32 x, y, z) and the faces (Uint32 triples).

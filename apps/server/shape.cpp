@@ -1,0 +1,71 @@
+#include "shape.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <fmt/format.h>
+
+#include "remora/common/error.h"
+#include "remora/geometry/selection.h"
+#include "remora/mesh/surface_point.h"
+
+namespace remora::server {
+
+Brush parse_brush(const std::string& name) {
+  if (name == "geodesic") return Brush::Geodesic;
+  if (name == "sphere") return Brush::Sphere;
+  throw InvalidArgument(fmt::format("unknown brush '{}': use geodesic or sphere", name));
+}
+
+Shape::Shape(const Mesh& mesh) : mesh_(mesh), marching_(mesh_) {}
+
+void Shape::set_positions(const Eigen::MatrixXd& positions) {
+  for (const VertexHandle v : mesh_.vertices())
+    mesh_.set_point(v, Vec3(positions(v.idx(), 0), positions(v.idx(), 1), positions(v.idx(), 2)));
+  stale_ = true;
+}
+
+void Shape::set_positions(const std::vector<int>& ids, const Eigen::MatrixXd& positions) {
+  for (const int i : ids)
+    mesh_.set_point(VertexHandle(i), Vec3(positions(i, 0), positions(i, 1), positions(i, 2)));
+  stale_ = true;
+}
+
+Pick Shape::pick(const Vec3& origin, const Vec3& direction, double radius, Brush brush) {
+  if (!(radius >= 0.0) || !std::isfinite(radius))
+    throw InvalidArgument(fmt::format("radius: {} must be finite and >= 0", radius));
+  if (!caster_)
+    caster_.emplace(mesh_);
+  else if (stale_)
+    caster_->refit(mesh_);
+  stale_ = false;
+  const RayHit hit =
+      caster_->first_hit(origin, direction, 0.0, std::numeric_limits<double>::infinity());
+  Pick out;
+  if (!hit.face.is_valid()) return out;
+  const SurfacePoint at{hit.face, hit.bary};
+  out.face = hit.face.idx();
+  out.point = evaluate(mesh_, at);
+  const auto corners = face_vertices(mesh_, hit.face);
+  double nearest = std::numeric_limits<double>::infinity();
+  for (const VertexHandle c : corners) {
+    const double d = (mesh_.point(c) - out.point).sqrnorm();
+    if (d < nearest) {
+      nearest = d;
+      out.vertex = c.idx();
+    }
+  }
+  if (radius <= 0.0) return out;
+  if (brush == Brush::Sphere) {
+    for (const int v : select_sphere(mesh_, out.point, radius))
+      out.brush.push_back(static_cast<std::uint32_t>(v));
+    return out;
+  }
+  for (const auto& [v, d] : marching_.ball(mesh_, at, radius))
+    out.brush.push_back(static_cast<std::uint32_t>(v));
+  std::sort(out.brush.begin(), out.brush.end());
+  return out;
+}
+
+} // namespace remora::server

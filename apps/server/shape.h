@@ -1,0 +1,56 @@
+// What the editor's page paints on: the mesh's faces at the positions the page shows (the edited
+// shape, live transforms included), a ray caster over them and the brushes. Picking and brushes
+// run here so that the page holds no second implementation of the library's geometry.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "remora/geometry/geodesic.h"
+#include "remora/geometry/raycast.h"
+#include "remora/mesh/mesh.h"
+
+namespace remora::server {
+
+enum class Brush {
+  Geodesic, ///< distance on the surface from the hit point (fast marching, geometry/geodesic.h)
+  Sphere,   ///< straight-line distance from the hit point
+};
+Brush parse_brush(const std::string& name); ///< "geodesic" or "sphere"; InvalidArgument else
+
+struct Pick {
+  int face = -1;                    ///< the face met first, -1 when the ray met nothing
+  Vec3 point{0, 0, 0};              ///< where
+  int vertex = -1;                  ///< the corner of that face nearest to the point
+  std::vector<std::uint32_t> brush; ///< the vertices within the radius of the point, by index
+};
+
+class Shape {
+public:
+  /// Copies the mesh (its faces and current positions).
+  explicit Shape(const Mesh& mesh);
+
+  /// Every vertex moves to the rows of `positions` (n_vertices × 3).
+  void set_positions(const Eigen::MatrixXd& positions);
+  /// Vertex ids[i] moves to row ids[i] of `positions` (the vertices a frame moved).
+  void set_positions(const std::vector<int>& ids, const Eigen::MatrixXd& positions);
+
+  /// The first face met by origin + t direction (t > 0) and the brush of `radius` around it.
+  /// The ray caster is refitted first when the positions changed. Throws InvalidArgument for a
+  /// non-finite or zero ray or a negative or non-finite radius.
+  Pick pick(const Vec3& origin, const Vec3& direction, double radius, Brush brush);
+
+  const Mesh& mesh() const { return mesh_; }
+
+private:
+  Mesh mesh_;
+  std::optional<RayCaster> caster_;
+  bool stale_ = true;
+  FastMarching marching_;
+};
+
+} // namespace remora::server

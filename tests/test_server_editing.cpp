@@ -1,0 +1,279 @@
+// The server's editing contract beyond the round trip (tests/test_server.cpp): a new k under moved
+// handles, transforms that would invert the patch, picking and brushes on the shape shown, the
+// change counters that spare the page its downloads, the progress of a job, and the HTTP binding
+// over loopback (405, 413 and every error with a JSON body).
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "api.h"
+#include "http.h"
+#include "remora/geometry/geodesic.h"
+#include "remora/geometry/raycast.h"
+#include "remora/mesh/io.h"
+#include "server_support.h"
+#include "session.h"
+
+// Last: httplib.h pulls in <resolv.h>, whose `_res` macro breaks Eigen's headers if they follow.
+#include <httplib.h> // NOLINT(llvm-include-order)
+
+namespace remora::server {
+namespace {
+
+using nlohmann::json;
+using namespace testing_server;
+
+json status_of(Session& s) {
+  return json::parse(call(s, "GET", "/api/status").body);
+}
+
+TEST(ServerEditing, ANewKKeepsTheMoveWithoutABakeAndUndoComesBack) {
+  Session s;
+  const SphereRegion r = load_sphere_with_region(s, 2);
+  const json ready = status_of(s);
+  ASSERT_EQ(move(s, {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0.4}).status, 200);
+  call(s, "POST", "/api/commit");
+  const auto k2 = as<float>(call(s, "GET", "/api/mesh/positions"));
+  const json moved = status_of(s);
+  // Same support and handle, k = 1: solved again under the same transform, no bake.
+  ASSERT_EQ(call(s, "POST", "/api/region",
+                 json{{"support", r.support}, {"handles", {r.handle}}, {"k", 1}}.dump())
+                .status,
+            202);
+  s.wait();
+  const json k1_status = status_of(s);
+  ASSERT_FALSE(k1_status.contains("error")) << k1_status;
+  EXPECT_EQ(k1_status["transforms"], moved["transforms"]);
+  EXPECT_EQ(k1_status["region"]["k"], 1);
+  EXPECT_EQ(k1_status["base"]["preprocess_ms"], ready["base"]["preprocess_ms"]); // same base
+  EXPECT_EQ(k1_status["mesh_id"], moved["mesh_id"]);
+  EXPECT_NE(k1_status["positions_id"], moved["positions_id"]);
+  EXPECT_NE(k1_status["region_id"], moved["region_id"]);
+  const auto k1 = as<float>(call(s, "GET", "/api/mesh/positions"));
+  double rise = 0, differ = 0;
+  for (const int v : r.handle) {
+    const auto i = 3 * static_cast<std::size_t>(v) + 2;
+    rise += (k1[i] - r.rest[i]) / double(r.handle.size());
+  }
+  for (std::size_t i = 0; i < k1.size(); ++i)
+    differ = std::max(differ, double(std::abs(k1[i] - k2[i])));
+  EXPECT_NEAR(rise, 0.4, 0.02); // the handle is where the drag left it
+  EXPECT_GT(differ, 1e-3);      // and the support bends as k = 1 bends it
+  // Undo: k = 2 under the same move, exactly.
+  EXPECT_TRUE(json::parse(call(s, "POST", "/api/undo").body)["changed"]);
+  EXPECT_EQ(as<float>(call(s, "GET", "/api/mesh/positions")), k2);
+  EXPECT_EQ(status_of(s)["region"]["k"], 2);
+}
+
+TEST(ServerEditing, MirrorsCollapsesAndNumbersOutOfRangeAreRefused) {
+  Session s;
+  load_sphere_with_region(s);
+  expect_error(move(s, {-1, 0, 0, 0, 0, -1, 0, 0, 0, 0, -1, 0}), 400, "mirrors");
+  expect_error(move(s, {-1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0}), 400, "mirrors");
+  expect_error(move(s, {0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0}), 400, "collapses");
+  expect_error(move(s, {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1e-9, 0}), 400, "collapses");
+  expect_error(call(s, "POST", "/api/transform",
+                    R"({"handle": 0, "matrix": [1e400,0,0,0,0,1,0,0,0,0,1,0]})"),
+               400, "not valid JSON");
+  // Refusals leave the shape as it was; a positive scale is an edit.
+  EXPECT_EQ(status_of(s)["transforms"][0], json({1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0}));
+  EXPECT_EQ(move(s, {0.5, 0, 0, 0, 0, 2, 0, 0, 0, 0, 1, 0}).status, 200);
+}
+
+/// The brush of a pick response as sorted ids, and its hit face.
+std::vector<std::uint32_t> brush_of(const HttpResponse& r) {
+  auto ids = as<std::uint32_t>(r);
+  std::sort(ids.begin(), ids.end());
+  return ids;
+}
+
+TEST(ServerEditing, PicksAndBrushesAreTheLibrarysOnTheShapeShown) {
+  Session s;
+  expect_error(call(s, "POST", "/api/pick", R"({"origin": [0,0,3], "direction": [0,0,-1]})"), 409,
+               "no mesh");
+  load_sphere_with_region(s);
+  const auto pick = [&](const Vec3& o, const Vec3& d, double radius, const char* brush) {
+    return call(s, "POST", "/api/pick",
+                json{{"origin", {o[0], o[1], o[2]}},
+                     {"direction", {d[0], d[1], d[2]}},
+                     {"radius", radius},
+                     {"brush", brush}}
+                    .dump());
+  };
+  // The library on the same mesh, the same ray and radius.
+  Mesh mesh = read_mesh_from_memory(sphere_off(), MeshFormat::Off, "sphere.off").mesh;
+  const Vec3 origin(0.1, 0.2, 3), down(0, 0, -1);
+  for (const double radius : {0.0, 0.1, 0.5}) {
+    const HttpResponse got = pick(origin, down, radius, "geodesic");
+    ASSERT_EQ(got.status, 200) << got.body;
+    const RayHit hit = RayCaster(mesh).first_hit(origin, down, 0.0, 1e300);
+    ASSERT_TRUE(hit.face.is_valid());
+    EXPECT_EQ(got.headers.at("X-Hit-Face"), std::to_string(hit.face.idx()));
+    std::vector<std::uint32_t> expected;
+    for (const auto& [v, d] : geodesic_ball(mesh, SurfacePoint{hit.face, hit.bary}, radius))
+      expected.push_back(static_cast<std::uint32_t>(v));
+    std::sort(expected.begin(), expected.end());
+    EXPECT_EQ(brush_of(got), expected) << "radius " << radius;
+  }
+  // A miss, and bad requests.
+  const HttpResponse miss = pick(Vec3(5, 5, 5), Vec3(1, 0, 0), 0.3, "geodesic");
+  EXPECT_EQ(miss.headers.at("X-Hit-Face"), "-1");
+  EXPECT_TRUE(miss.body.empty());
+  expect_error(pick(origin, Vec3(0, 0, 0), 0.1, "geodesic"), 400, "direction");
+  expect_error(pick(origin, down, -1, "geodesic"), 400, "radius");
+  expect_error(pick(origin, down, 0.1, "lasso"), 400, "unknown brush 'lasso'");
+  expect_error(call(s, "POST", "/api/pick", R"({"origin": [0,0,"x"], "direction": [0,0,-1]})"), 400,
+               "origin[2]");
+  // After a lift the handle is higher: the ray meets the lifted top, and the brush is the
+  // library's on the moved mesh.
+  ASSERT_EQ(move(s, {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0.5}).status, 200);
+  const Vec3 above(0.0, 0.0, 3);
+  const HttpResponse lifted = pick(above, down, 0.2, "geodesic");
+  const auto moved = as<float>(call(s, "GET", "/api/mesh/positions"));
+  for (const VertexHandle v : mesh.vertices()) {
+    const auto i = 3 * static_cast<std::size_t>(v.idx());
+    mesh.set_point(v, Vec3(moved[i], moved[i + 1], moved[i + 2]));
+  }
+  const RayHit hit = RayCaster(mesh).first_hit(above, down, 0.0, 1e300);
+  ASSERT_TRUE(hit.face.is_valid());
+  EXPECT_EQ(lifted.headers.at("X-Hit-Face"), std::to_string(hit.face.idx()));
+  EXPECT_GT(evaluate(mesh, SurfacePoint{hit.face, hit.bary})[2], 1.3);
+  std::vector<std::uint32_t> expected;
+  for (const auto& [v, d] : geodesic_ball(mesh, SurfacePoint{hit.face, hit.bary}, 0.2))
+    expected.push_back(static_cast<std::uint32_t>(v));
+  std::sort(expected.begin(), expected.end());
+  EXPECT_EQ(brush_of(lifted), expected);
+  // The sphere brush: the straight-line ball around the hit point.
+  const HttpResponse sphere = pick(above, down, 0.2, "sphere");
+  const Vec3 at = evaluate(mesh, SurfacePoint{hit.face, hit.bary});
+  std::vector<std::uint32_t> within;
+  for (const VertexHandle v : mesh.vertices())
+    if ((mesh.point(v) - at).norm() <= 0.2) within.push_back(static_cast<std::uint32_t>(v.idx()));
+  EXPECT_EQ(brush_of(sphere), within);
+}
+
+TEST(ServerEditing, TheCountersChangeOnlyWithWhatTheyCount) {
+  Session s;
+  const json empty = status_of(s);
+  const SphereRegion r = load_sphere_with_region(s);
+  const json loaded = status_of(s);
+  EXPECT_NE(loaded["mesh_id"], empty["mesh_id"]);
+  // A frame of a drag and its commit: the page has those positions already.
+  ASSERT_EQ(move(s, {1, 0, 0, 0.1, 0, 1, 0, 0, 0, 0, 1, 0}).status, 200);
+  call(s, "POST", "/api/commit");
+  const json dragged = status_of(s);
+  for (const char* id : {"mesh_id", "positions_id", "region_id"})
+    EXPECT_EQ(dragged[id], loaded[id]) << id;
+  // Undo of the drag: positions, not the region.
+  call(s, "POST", "/api/undo");
+  const json undone = status_of(s);
+  EXPECT_NE(undone["positions_id"], dragged["positions_id"]);
+  EXPECT_EQ(undone["region_id"], dragged["region_id"]);
+  EXPECT_EQ(undone["mesh_id"], dragged["mesh_id"]);
+  // A new region after a move (a bake): the region, not the faces nor the positions shown.
+  call(s, "POST", "/api/redo");
+  const json redone = status_of(s);
+  std::vector<int> smaller(r.support.begin() + 1, r.support.end());
+  if (std::find(r.handle.begin(), r.handle.end(), r.support.front()) != r.handle.end())
+    smaller = r.support;
+  ASSERT_EQ(
+      call(s, "POST", "/api/region", json{{"support", smaller}, {"handles", {r.handle}}}.dump())
+          .status,
+      202);
+  s.wait();
+  const json baked = status_of(s);
+  ASSERT_FALSE(baked.contains("error")) << baked;
+  EXPECT_NE(baked["region_id"], redone["region_id"]);
+  EXPECT_EQ(baked["positions_id"], redone["positions_id"]);
+  EXPECT_EQ(baked["mesh_id"], redone["mesh_id"]);
+}
+
+TEST(ServerEditing, AJobsProgressRunsForwardToTheEnd) {
+  Session s;
+  // Large enough that the polls see several phases.
+  const Mesh big = make_icosphere(6, 1.0);
+  const std::string bytes = write_mesh_to_memory(big, MeshFormat::Ply, "big.ply");
+  ASSERT_EQ(call(s, "POST", "/api/load", bytes, {{"name", "big.ply"}}).status, 202);
+  std::vector<double> seen;
+  for (;;) {
+    const json st = status_of(s);
+    if (st["state"] != "busy") break;
+    const double f = st["progress"]["fraction"];
+    seen.push_back(f);
+    EXPECT_GE(f, 0.0);
+    EXPECT_LE(f, 1.0);
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  ASSERT_GT(seen.size(), 2u);
+  EXPECT_TRUE(std::is_sorted(seen.begin(), seen.end()));
+  EXPECT_GT(seen.back(), 0.5);
+}
+
+/// `remora serve`'s binding on a free loopback port, with a client.
+class Loopback {
+public:
+  explicit Loopback(Session& session, ApiLimits limits = {}) : limits_(limits) {
+    bind_http(http_, session, limits_, "");
+    port_ = http_.bind_to_any_port("127.0.0.1");
+    listener_ = std::thread([this] { http_.listen_after_bind(); });
+  }
+  ~Loopback() {
+    http_.stop();
+    listener_.join();
+  }
+  Loopback(const Loopback&) = delete;
+  Loopback& operator=(const Loopback&) = delete;
+  httplib::Client client() const { return httplib::Client("127.0.0.1", port_); }
+
+private:
+  ApiLimits limits_;
+  httplib::Server http_;
+  int port_ = 0;
+  std::thread listener_;
+};
+
+void expect_json_error(const httplib::Result& r, int status, const std::string& part) {
+  ASSERT_TRUE(r) << httplib::to_string(r.error());
+  EXPECT_EQ(r->status, status) << r->body;
+  EXPECT_EQ(r->get_header_value("Content-Type"), "application/json");
+  const json j = json::parse(r->body, nullptr, false);
+  ASSERT_TRUE(j.is_object() && j.contains("error")) << r->body;
+  EXPECT_NE(j["error"].get<std::string>().find(part), std::string::npos) << r->body;
+}
+
+TEST(ServerEditing, OverHttpEveryErrorIsJsonAndWrongMethodsAre405) {
+  Session s;
+  ApiLimits limits;
+  limits.max_upload_bytes = 1000;
+  Loopback server(s, limits);
+  httplib::Client c = server.client();
+  c.set_keep_alive(true);
+  EXPECT_EQ(c.Get("/api/status")->status, 200);
+  const auto del = c.Delete("/api/status");
+  expect_json_error(del, 405, "does not take DELETE");
+  EXPECT_EQ(del->get_header_value("Allow"), "GET");
+  expect_json_error(c.Put("/api/region", "{}", "application/json"), 405, "does not take PUT");
+  expect_json_error(c.Patch("/api/transform", "{}", "application/json"), 405,
+                    "does not take PATCH");
+  expect_json_error(c.Delete("/index.html"), 405, "only GET");
+  expect_json_error(c.Get("/index.html"), 404, "no page");
+  // Larger than the upload limit: httplib answers by itself, with our JSON.
+  expect_json_error(
+      c.Post("/api/load?name=a.ply", std::string(5000, 'x'), "application/octet-stream"), 413,
+      "upload limit of 1000 bytes");
+  expect_json_error(
+      c.Post("/api/load?name=a.ply", std::string(5000, 'x'), "application/x-www-form-urlencoded"),
+      413, "application/octet-stream");
+  expect_json_error(
+      c.Post("/api/transform", R"({"handle": 0, "matrix": [1e400]})", "application/json"), 400,
+      "number overflow");
+}
+
+} // namespace
+} // namespace remora::server
