@@ -107,6 +107,15 @@ TEST(EditRequest, ErrorsNameTheJsonPath) {
       error_of({{"support", {{"box", {{"min", {0, 0, 0}}, {"size", 1}}}}}, {"handles", handles}})
           .find("unknown key 'size' (allowed: min, max)"),
       std::string::npos);
+  // Transforms that mirror or collapse the handle are refused before any work.
+  const json mirror = json::parse(
+      R"([{"region": [1], "transform": {"matrix": [[-1,0,0,0],[0,1,0,0],[0,0,1,0]]}}])");
+  EXPECT_NE(error_of({{"support", {1}}, {"handles", mirror}}).find("mirrors or collapses"),
+            std::string::npos);
+  const json flat =
+      json::parse(R"([{"region": [1], "transform": {"scale": {"factors": [1, 0, 1]}}}])");
+  EXPECT_NE(error_of({{"support", {1}}, {"handles", flat}}).find("factors: must be > 0"),
+            std::string::npos);
 }
 
 TEST(Selection, SpheresBoxesAndGeodesicDiscs) {

@@ -211,6 +211,9 @@ EditRequest edit_request(const EditArgs& a) {
   if (!a.scale.empty()) {
     const auto v = numbers(a.scale, 3, "--scale");
     h.transform.scale = Eigen::Vector3d(v[0], v[1], v[2]);
+    if (!(h.transform.scale->minCoeff() > 0.0))
+      throw InvalidArgument(
+          "--scale: every factor must be > 0 (0 collapses the handle, < 0 mirrors it)");
   }
   if (!a.rotate.empty()) {
     const auto v = numbers(a.rotate, 4, "--rotate");

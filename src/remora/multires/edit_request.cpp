@@ -143,6 +143,8 @@ TransformSpec parse_transform(const json& j, const std::string& path) {
         matrix(r, c) =
             number(row[static_cast<std::size_t>(c)], fmt::format("{}[{}][{}]", sub, r, c));
     }
+    if (!(matrix.leftCols<3>().determinant() > 0.0))
+      fail(sub, "the linear part mirrors or collapses the handle (det <= 0)");
     t.matrix = matrix;
     return t;
   }
@@ -151,6 +153,8 @@ TransformSpec parse_transform(const json& j, const std::string& path) {
     const std::string sub = path + ".scale";
     only_keys(s, sub, {"factors", "center"});
     t.scale = vec3(member(s, sub, "factors"), sub + ".factors");
+    if (!(t.scale->minCoeff() > 0.0))
+      fail(sub + ".factors", "must be > 0 on every axis (0 collapses the handle, < 0 mirrors it)");
     if (s.contains("center")) t.scale_center = vec3(s.at("center"), sub + ".center");
   }
   if (j.contains("rotate")) {
