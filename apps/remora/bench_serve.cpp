@@ -12,6 +12,7 @@
 #include <memory>
 #include <sstream>
 #include <thread>
+#include <utility>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -35,6 +36,7 @@ namespace {
 struct BenchServeArgs {
   std::string mesh = std::string(REMORA_REPO_DATA) + "/bunny.ply";
   int support = 15000, requests = 200;
+  double brush = 0.125; ///< the brush radius of the timed picks, in bounding-sphere radii
   bool json = false;
 };
 
@@ -114,6 +116,35 @@ nlohmann::json load_with_region(Loopback& server, const std::string& path, int s
   return server.wait_ready();
 }
 
+/// Times `count` picks (POST /api/pick, geodesic brush of `radius`) of the rays that look at the
+/// vertex nearest the centroid along its normal, nudged sideways a little each time. Returns the
+/// round trips and the brush size of the last one.
+std::pair<std::vector<double>, std::size_t> time_picks(Loopback& server, const Mesh& mesh,
+                                                       double radius, int count) {
+  const VertexHandle seed = central_vertex(mesh);
+  Vec3 normal(0, 0, 0);
+  for (const FaceHandle f : mesh.vf_range(seed)) normal += mesh.calc_face_normal(f);
+  normal.normalize();
+  const Vec3 at = mesh.point(seed);
+  double extent = 0;
+  for (const VertexHandle v : mesh.vertices())
+    extent = std::max(extent, (mesh.point(v) - at).norm());
+  std::vector<double> trips;
+  std::size_t brush = 0;
+  for (int i = 0; i < count; ++i) {
+    const Vec3 origin = at + normal * extent + Vec3(1e-4 * extent * (i % 5), 0, 0);
+    const Vec3 d = -normal;
+    const nlohmann::json body = {{"origin", {origin[0], origin[1], origin[2]}},
+                                 {"direction", {d[0], d[1], d[2]}},
+                                 {"radius", radius}};
+    const auto t0 = Clock::now();
+    brush = ok(server.client().Post("/api/pick", body.dump(), "application/json"), "pick").size() /
+            sizeof(std::uint32_t);
+    trips.push_back(ms_since(t0));
+  }
+  return {trips, brush};
+}
+
 double quantile(std::vector<double> v, double q) {
   std::sort(v.begin(), v.end());
   return v[std::min(v.size() - 1, static_cast<std::size_t>(q * double(v.size())))];
@@ -142,6 +173,12 @@ void run_bench_serve(const BenchServeArgs& a) {
     frames.push_back(std::stod(r->get_header_value("X-Frame-Ms")));
     floats = positions.size() / sizeof(float);
   }
+  const Mesh mesh = read_mesh(a.mesh).mesh;
+  double bound = 0;
+  const VertexHandle centre = central_vertex(mesh);
+  for (const VertexHandle v : mesh.vertices())
+    bound = std::max(bound, (mesh.point(v) - mesh.point(centre)).norm());
+  const auto [picks, brush] = time_picks(server, mesh, a.brush * bound, 50);
   const nlohmann::json result = {{"mesh", a.mesh},
                                  {"support", status["region"]["support"]},
                                  {"free_base_vertices", status["region"]["free_base_vertices"]},
@@ -151,6 +188,8 @@ void run_bench_serve(const BenchServeArgs& a) {
                                  {"round_trip_ms_max", quantile(round_trips, 1.0)},
                                  {"frame_ms_median", quantile(frames, 0.5)},
                                  {"status_round_trip_ms_median", quantile(status_trips, 0.5)},
+                                 {"pick_round_trip_ms_median", quantile(picks, 0.5)},
+                                 {"brush_vertices", brush},
                                  {"requests", a.requests}};
   if (a.json) {
     std::cout << result.dump(2) << "\n";
@@ -159,11 +198,12 @@ void run_bench_serve(const BenchServeArgs& a) {
   std::cout << fmt::format(
       "{}: support {} vertices ({} free on the base), {} positions per answer ({:.0f} KB)\n"
       "transform request -> positions received: median {:.2f} ms, p95 {:.2f} ms, max {:.2f} ms "
-      "over {} requests (server frame {:.2f} ms); GET /api/status: median {:.2f} ms\n",
+      "over {} requests (server frame {:.2f} ms); GET /api/status: median {:.2f} ms\n"
+      "pick with a geodesic brush of {} vertices: median {:.2f} ms\n",
       a.mesh, result["support"].get<std::size_t>(), result["free_base_vertices"].get<std::size_t>(),
       floats / 3, double(floats * 4) / 1024, quantile(round_trips, 0.5),
       quantile(round_trips, 0.95), quantile(round_trips, 1.0), a.requests, quantile(frames, 0.5),
-      quantile(status_trips, 0.5));
+      quantile(status_trips, 0.5), brush, quantile(picks, 0.5));
 }
 
 } // namespace
@@ -177,6 +217,9 @@ void add_bench_serve_command(CLI::App& bench) {
       ->check(CLI::PositiveNumber);
   cmd->add_option("--requests", a->requests, "Transform requests to time (default 200)")
       ->check(CLI::PositiveNumber);
+  cmd->add_option("--brush", a->brush,
+                  "Radius of the timed picks' brush, in bounding radii (default 0.125)")
+      ->check(CLI::NonNegativeNumber);
   cmd->add_flag("--json", a->json, "Print one JSON object");
   cmd->callback([a] { run_bench_serve(*a); });
 }

@@ -80,7 +80,7 @@ FastMarching::march(const Mesh& mesh, const std::vector<std::pair<int, double>>&
   std::priority_queue<Item, std::vector<Item>, std::greater<>> front;
   auto offer = [&](int v, double d) {
     const auto i = static_cast<std::size_t>(v);
-    if (!(d < distance_[i])) return;
+    if (!(d < distance_[i]) || d > radius) return; // beyond the radius it is never accepted
     if (state_[i] == kFar) {
       state_[i] = kTrial;
       touched_.push_back(v);
@@ -95,7 +95,6 @@ FastMarching::march(const Mesh& mesh, const std::vector<std::pair<int, double>>&
     front.pop();
     const auto i = static_cast<std::size_t>(v);
     if (state_[i] == kAccepted || d > distance_[i]) continue; // a stale entry
-    if (d > radius) break;
     state_[i] = kAccepted;
     out.emplace_back(v, d);
     const Vec3& pv = points[i];
