@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
-# Puts the browser editor's files where `remora serve` finds them: the page (web/*.html, *.js,
-# *.css) and the parts of three.js it imports, from web/node_modules (npm, installed here when
-# missing: `npm ci` from web/package-lock.json). No CDN: the page works offline.
+# Puts the browser editor's files where `remora serve` finds them: the page (web/index.html,
+# style.css and its modules web/*.js) and the parts of three.js it imports, from web/node_modules
+# (npm, installed here when missing: `npm ci` from web/package-lock.json). No CDN: the page works
+# offline.
 #
 #   scripts/build_web.sh OUT_DIR
 #
@@ -45,7 +46,8 @@ if ! installed; then
 fi
 
 mkdir -p "$out/three/build" "$out/three/examples/jsm/controls"
-cp "$web/index.html" "$web/app.js" "$web/style.css" "$out/"
+# The page: index.html, style.css and every ES module beside app.js (web/*.js).
+cp "$web/index.html" "$web/style.css" "$web"/*.js "$out/"
 cp "$web/node_modules/three/build/three.module.js" "$out/three/build/"
 cp "$web/node_modules/three/examples/jsm/controls/OrbitControls.js" \
    "$web/node_modules/three/examples/jsm/controls/TransformControls.js" \

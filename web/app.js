@@ -1,13 +1,16 @@
 // The browser editor of `remora serve` (docs/server.md): paint a support and handles on the mesh,
 // drag a handle with a manipulator, watch the support bend while the details ride along. All the
-// geometry work happens on the server (the editing kernel); this page paints, sends, and draws.
+// geometry work happens on the server (the editing kernel, picking and brushes); this page paints,
+// sends, and draws. This file holds the state of the edit and wires the modules together:
+// view.js draws, api.js talks to the server, picking.js asks it what is under the pointer,
+// panels.js is the panel and the keyboard.
 import * as THREE from 'three';
-import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
-import { TransformControls } from 'three/addons/controls/TransformControls.js';
+import { ApiError, api, binary, json, message, post, task, waitUntilReady, work } from './api.js';
+import * as view from './view.js';
+import { FIXED, FREE } from './view.js';
+import { Coalescer, faceNormal, pick } from './picking.js';
+import * as panels from './panels.js';
 
-const FIXED = -2, FREE = -1;
-const HANDLE_COLORS = [[0.90, 0.30, 0.25], [0.25, 0.55, 0.95], [0.30, 0.80, 0.40], [0.85, 0.45, 0.90],
-                       [0.95, 0.60, 0.20], [0.20, 0.80, 0.80]];
 const $ = (id) => document.getElementById(id);
 // Display options in the URL (rendering only; scripts/render_pictures.mjs uses them):
 //   ui=0                          no panel, messages, progress or manipulator over the view;
@@ -25,329 +28,202 @@ if (cameraParam && !((cameraParam.length === 6 || cameraParam.length === 9) && c
   console.error('camera= needs 6 or 9 numbers: px,py,pz,tx,ty,tz[,ux,uy,uz]; ignored');
   cameraParam = null;
 }
-
-// ---- view ---------------------------------------------------------------------------------------
-const view = $('view');
-const renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
-renderer.setPixelRatio(window.devicePixelRatio);
-view.appendChild(renderer.domElement);
-const scene = new THREE.Scene();
-scene.background = new THREE.Color(0x20242a);
-const camera = new THREE.PerspectiveCamera(40, 1, 0.001, 1000);
-scene.add(camera);
-// Before the orbit controls, which orbit about the up they find.
-if (cameraParam?.length === 9) camera.up.fromArray(cameraParam, 6).normalize();
-// A headlight and a grazing key light: surface detail shows as shading.
-scene.add(new THREE.HemisphereLight(0xffffff, 0x404048, 0.9));
-const key = new THREE.DirectionalLight(0xffffff, 1.6);
-key.position.set(-1, 1.5, 1);
-camera.add(key);
-const orbit = new OrbitControls(camera, renderer.domElement);
-orbit.enableDamping = false;
-const gizmo = new TransformControls(camera, renderer.domElement);
-const pivot = new THREE.Object3D();
-scene.add(pivot);
-const gizmoHelper = gizmo.getHelper ? gizmo.getHelper() : gizmo;
-scene.add(gizmoHelper);
-
-// The surface sits a little behind its own wireframe (show-edges), which shares its geometry.
-const material = new THREE.MeshStandardMaterial({ vertexColors: true, roughness: 0.75, metalness: 0.0,
-                                                  side: THREE.DoubleSide,
-                                                  polygonOffset: true, polygonOffsetFactor: 1, polygonOffsetUnits: 1 });
-const edgeMaterial = new THREE.MeshBasicMaterial({ color: 0x30343c, wireframe: true });
-let mesh = null, edges = null, baseLines = null;
-
-function resize() {
-  const w = view.clientWidth, h = view.clientHeight;
-  renderer.setSize(w, h);
-  camera.aspect = w / Math.max(h, 1);
-  camera.updateProjectionMatrix();
-}
-window.addEventListener('resize', resize);
-resize();
-renderer.setAnimationLoop(() => renderer.render(scene, camera));
+view.createControls(cameraParam?.length === 9 ? cameraParam.slice(6) : null);
+const { orbit, gizmo, pivot } = view;
 
 // ---- state --------------------------------------------------------------------------------------
+const MIN_SCALE = 0.05; // the manipulator's smallest scale per axis: the map keeps det(M) > 0
 const state = {
   tool: 'orbit', selected: 0, handleCount: 1, k: 2,
-  labels: null, positions: null, indices: null, neighbours: null, offsets: null,
-  movable: null, transforms: [], dirtyRegion: false, status: null,
-  tasks: 0, // requests and refreshes under way (the end-to-end test waits for 0)
+  labels: null, positions: null, indices: null, // labels: FIXED, FREE or a handle index per vertex
+  movable: null, serverHandles: 0, transforms: [], dirtyRegion: false, status: null, frameMs: undefined,
+  held: { mesh: undefined, positions: undefined, region: undefined }, // the status ids of what the page holds
+  marks: { paintMove: [], drag: [], dragBytes: [], regionReady: [], strokeEnd: null, paintable: null },
 };
+const busy = () => state.status?.state === 'busy';
 
-/// Runs an asynchronous piece of work, counted in state.tasks.
-async function task(work) {
-  state.tasks += 1;
-  try { return await work(); } finally { state.tasks -= 1; }
+/// Polls until the server is idle, showing the progress; returns the status (its error shown).
+async function settle() {
+  const s = await waitUntilReady((b) => { state.status = b; panels.showProgress(b); placeGizmo(true); });
+  $('progress').hidden = true;
+  return s;
 }
 
-// ---- messages and the API -----------------------------------------------------------------------
-function message(text, kind = 'error') {
-  const box = $('message');
-  box.textContent = text;
-  box.className = kind;
-  box.hidden = !text;
-  if (kind === 'info' && text) setTimeout(() => { if (box.textContent === text) box.hidden = true; }, 2500);
-}
+// ---- what the page holds: brought up to a status ------------------------------------------------
+const changed = (id, held) => id === undefined || id !== held;
 
-async function api(path, options = {}) {
-  const response = await fetch('api/' + path, options);
-  if (!response.ok) {
-    let text = `${response.status} ${response.statusText}`;
-    try { text = (await response.json()).error || text; } catch (e) { /* not JSON */ }
-    message(text);
-    throw new Error(text);
-  }
-  return response;
-}
-const json = async (path, options) => (await api(path, options)).json();
-const binary = async (path, Type) => new Type(await (await api(path)).arrayBuffer());
-const post = (path, body) => api(path, { method: 'POST', headers: { 'Content-Type': 'application/json' },
-                                         body: JSON.stringify(body ?? {}) });
-
-async function waitUntilReady() {
-  for (;;) {
-    const s = await json('status');
-    state.status = s;
-    if (s.state !== 'busy') {
-      $('progress').hidden = true;
-      if (s.error) message(s.error);
-      showStats();
-      return s;
-    }
-    const p = s.progress || {};
-    $('progress').hidden = false;
-    $('progress-text').textContent = `${p.job}: ${p.phase}`;
-    $('progress-bar').style.width = p.steps ? `${100 * p.step / p.steps}%` : '15%';
-    await new Promise((r) => setTimeout(r, 150));
-  }
-}
-
-// ---- the mesh -----------------------------------------------------------------------------------
-async function fetchMesh(fit) {
-  const s = await waitUntilReady();
+/// Brings the page up to the ready status `s`, downloading only what changed: the faces when
+/// mesh_id changed, the positions when positions_id changed, the region and movable vertices when
+/// region_id changed (only the movable ones when `labelsKnown`: the page sent that region itself).
+async function sync(s, { fit = false, labelsKnown = false, keepGizmo = false } = {}) {
+  state.status = s;
+  panels.showStats(s, state.frameMs);
   if (s.state !== 'ready') return;
-  state.indices = await binary('mesh/indices', Uint32Array);
-  state.positions = await binary('mesh/positions', Float32Array);
-  const n = state.positions.length / 3;
-  buildAdjacency(n);
-  const geometry = new THREE.BufferGeometry();
-  geometry.setAttribute('position', new THREE.BufferAttribute(state.positions, 3));
-  geometry.setAttribute('color', new THREE.BufferAttribute(new Float32Array(3 * n), 3));
-  geometry.setIndex(new THREE.BufferAttribute(state.indices, 1));
-  geometry.computeVertexNormals();
-  geometry.computeBoundingSphere();
-  if (mesh) { scene.remove(mesh); scene.remove(edges); mesh.geometry.dispose(); }
-  mesh = new THREE.Mesh(geometry, material);
-  edges = new THREE.Mesh(geometry, edgeMaterial);
-  showMesh();
-  scene.add(mesh);
-  scene.add(edges);
-  await fetchRegion();
-  if (fit) fitCamera();
-  if (baseShown()) await showBase(true);
-}
-
-function fitCamera() {
-  const sphere = mesh.geometry.boundingSphere;
-  orbit.target.copy(sphere.center);
-  camera.near = sphere.radius / 100;
-  camera.far = sphere.radius * 100;
-  camera.position.copy(sphere.center).add(new THREE.Vector3(0, 0, sphere.radius * 2.8));
-  if (cameraParam) {
-    camera.position.fromArray(cameraParam, 0);
-    orbit.target.fromArray(cameraParam, 3);
+  let fresh = false, moved = false;
+  if (!state.indices || changed(s.mesh_id, state.held.mesh)) {
+    state.indices = await binary('mesh/indices', Uint32Array);
+    state.positions = await binary('mesh/positions', Float32Array);
+    view.setMesh(state.positions, state.indices);
+    showMesh();
+    fresh = true;
+  } else if (changed(s.positions_id, state.held.positions)) {
+    state.positions.set(await binary('mesh/positions', Float32Array));
+    view.positionsChanged();
+    moved = true;
   }
-  camera.updateProjectionMatrix();
-  orbit.update();
-  $('radius').max = (sphere.radius).toPrecision(3);
-  $('radius').min = (sphere.radius / 200).toPrecision(3);
-  $('radius').step = (sphere.radius / 1000).toPrecision(3);
-  $('radius').value = (sphere.radius / 8).toPrecision(3);
-  $('radius-value').textContent = $('radius').value;
+  state.held.mesh = s.mesh_id;
+  state.held.positions = s.positions_id;
+  const regionChanged = fresh || changed(s.region_id, state.held.region);
+  if (regionChanged) await fetchRegion(s, labelsKnown && !fresh);
+  state.transforms = (s.transforms || []).map(rowsToMatrix);
+  if (fit) panels.fitRadius(view.fitCamera(cameraParam));
+  showHandleButtons();
+  placeGizmo(keepGizmo && !fresh);
+  if (baseShown() && (fresh || regionChanged || moved || !view.hasBase())) await showBase(fresh || regionChanged || !view.hasBase());
 }
 
-function buildAdjacency(n) {
-  const count = new Uint32Array(n + 1);
-  const f = state.indices;
-  for (let i = 0; i < f.length; i += 3)
-    for (let k = 0; k < 3; ++k) { count[f[i + k] + 1] += 2; }
-  for (let v = 0; v < n; ++v) count[v + 1] += count[v];
-  const fill = count.slice(0, n);
-  const neighbours = new Uint32Array(count[n]);
-  for (let i = 0; i < f.length; i += 3)
-    for (let k = 0; k < 3; ++k) {
-      const a = f[i + k];
-      neighbours[fill[a]++] = f[i + (k + 1) % 3];
-      neighbours[fill[a]++] = f[i + (k + 2) % 3];
+async function fetchRegion(s, labelsKnown) {
+  if (!labelsKnown) {
+    const n = state.positions.length / 3;
+    state.labels = new Int32Array(n).fill(FIXED);
+    const region = await json('region');
+    if (region) {
+      for (const v of region.support) state.labels[v] = FREE;
+      region.handles.forEach((h, j) => { for (const v of h) state.labels[v] = j; });
+      state.k = region.k;
+      panels.setK(region.k);
     }
-  state.offsets = count;
-  state.neighbours = neighbours;
+    state.handleCount = Math.max(1, region?.handles.length ?? 0);
+    state.selected = Math.min(state.selected, state.handleCount - 1);
+    view.colour(state.labels);
+  }
+  state.serverHandles = s.region?.handles ?? 0;
+  state.movable = s.region ? await binary('movable', Uint32Array) : null;
+  view.setMovable(state.movable);
+  state.held.region = s.region_id;
 }
 
-async function fetchRegion() {
-  const n = state.positions.length / 3;
-  state.labels = new Int32Array(n).fill(FIXED);
-  const region = await json('region');
-  state.movable = null;
-  if (region) {
-    for (const v of region.support) state.labels[v] = FREE;
-    region.handles.forEach((h, j) => { for (const v of h) state.labels[v] = j; });
-    state.handleCount = Math.max(1, region.handles.length);
-    state.k = region.k;
-    $('k').value = String(region.k);
-    state.movable = await binary('movable', Uint32Array);
-    const s = state.status;
-    state.transforms = (s.transforms || []).map(rowsToMatrix);
-  } else {
-    state.handleCount = 1;
-    state.transforms = [];
+// ---- painting: the server picks, the page colours -----------------------------------------------
+let painting = false, lastHover = null;
+const picks = new Coalescer((q) => pick(q.ray, q.radius, q.brush), onPick);
+
+function onPick(hit, q) {
+  if (q.paint && !painting && q.stroke !== strokeCount) return; // a stroke's late answer after the next began
+  lastHover = hit;
+  if (hit.face < 0 || !hit.point || state.tool === 'orbit') { view.hideCursor(); return; }
+  view.showCursor(hit.point, faceNormal(state.positions, state.indices, hit.face), panels.radius());
+  if (q.paint) {
+    paint(hit.ids);
+    state.marks.paintMove.push(performance.now() - q.t0);
   }
-  state.selected = Math.min(state.selected, state.handleCount - 1);
-  updateHandleButtons();
-  recolour();
-  placeGizmo();
 }
 
-function recolour() {
-  if (!mesh) return;
-  const colours = mesh.geometry.getAttribute('color');
-  const c = colours.array;
-  for (let v = 0; v < state.labels.length; ++v) {
-    const l = state.labels[v];
-    const rgb = l === FIXED ? [0.78, 0.78, 0.78] : l === FREE ? [0.96, 0.86, 0.45] : HANDLE_COLORS[l % HANDLE_COLORS.length];
-    c[3 * v] = rgb[0]; c[3 * v + 1] = rgb[1]; c[3 * v + 2] = rgb[2];
-  }
-  colours.needsUpdate = true;
-}
-
-// ---- painting -----------------------------------------------------------------------------------
-const raycaster = new THREE.Raycaster();
-let painting = false;
-
-function hitAt(event) {
-  if (!mesh) return null;
-  const rect = renderer.domElement.getBoundingClientRect();
-  const ndc = new THREE.Vector2(((event.clientX - rect.left) / rect.width) * 2 - 1,
-                                -((event.clientY - rect.top) / rect.height) * 2 + 1);
-  raycaster.setFromCamera(ndc, camera);
-  const hits = raycaster.intersectObject(mesh, false);
-  return hits.length ? hits[0] : null;
-}
-
-function brushVertices(hit) {
-  const radius = parseFloat($('radius').value);
-  const p = state.positions, point = hit.point;
-  const out = [];
-  if (!$('geodesic').checked) {
-    const r2 = radius * radius;
-    for (let v = 0; v < p.length / 3; ++v) {
-      const dx = p[3 * v] - point.x, dy = p[3 * v + 1] - point.y, dz = p[3 * v + 2] - point.z;
-      if (dx * dx + dy * dy + dz * dz <= r2) out.push(v);
-    }
-    return out;
-  }
-  // Geodesic: Dijkstra over the edges from the hit face's corners.
-  const dist = new Map();
-  const heap = [];
-  const push = (d, v) => { heap.push([d, v]); let i = heap.length - 1;
-    while (i > 0) { const parent = (i - 1) >> 1; if (heap[parent][0] <= heap[i][0]) break;
-      [heap[parent], heap[i]] = [heap[i], heap[parent]]; i = parent; } };
-  const pop = () => { const top = heap[0]; const last = heap.pop();
-    if (heap.length) { heap[0] = last; let i = 0;
-      for (;;) { const l = 2 * i + 1, r = l + 1; let m = i;
-        if (l < heap.length && heap[l][0] < heap[m][0]) m = l;
-        if (r < heap.length && heap[r][0] < heap[m][0]) m = r;
-        if (m === i) break; [heap[m], heap[i]] = [heap[i], heap[m]]; i = m; } }
-    return top; };
-  for (const v of [hit.face.a, hit.face.b, hit.face.c]) {
-    const d = Math.hypot(p[3 * v] - point.x, p[3 * v + 1] - point.y, p[3 * v + 2] - point.z);
-    if (!dist.has(v) || d < dist.get(v)) { dist.set(v, d); push(d, v); }
-  }
-  const done = new Set();
-  while (heap.length) {
-    const [d, v] = pop();
-    if (done.has(v) || d > radius) continue;
-    done.add(v);
-    out.push(v);
-    for (let k = state.offsets[v]; k < state.offsets[v + 1]; ++k) {
-      const w = state.neighbours[k];
-      const nd = d + Math.hypot(p[3 * v] - p[3 * w], p[3 * v + 1] - p[3 * w + 1], p[3 * v + 2] - p[3 * w + 2]);
-      if (nd <= radius && (!dist.has(w) || nd < dist.get(w))) { dist.set(w, nd); push(nd, w); }
-    }
-  }
-  return out;
-}
-
-function paint(hit) {
+function paint(ids) {
   const label = state.tool === 'support' ? FREE : state.tool === 'handle' ? state.selected : FIXED;
-  for (const v of brushVertices(hit)) {
+  const touched = [];
+  for (const v of ids) {
     const old = state.labels[v];
     if (state.tool === 'support' && old >= 0) continue; // painting the support keeps handles
-    if (old !== label) { state.labels[v] = label; state.dirtyRegion = true; }
+    if (old !== label) { state.labels[v] = label; touched.push(v); }
   }
-  recolour();
+  if (touched.length) { state.dirtyRegion = true; view.colour(state.labels, touched); }
 }
 
-renderer.domElement.addEventListener('pointerdown', (event) => {
-  if (state.tool === 'orbit' || event.button !== 0 || gizmo.dragging) return;
-  const hit = hitAt(event);
-  if (!hit) return; // a miss orbits
+let strokeCount = 0;
+function submitPick(event, paintIt) {
+  picks.submit({ ray: view.rayAt(event), radius: paintIt ? panels.radius() : 0, brush: panels.brush(),
+                 paint: paintIt, stroke: strokeCount, t0: performance.now() });
+}
+
+// In the capture phase, before the orbit controls: a stroke that starts on the mesh paints, one
+// that starts off it (as the last hover pick says) orbits.
+view.container.addEventListener('pointerdown', (event) => {
+  if (state.tool === 'orbit' || event.button !== 0 || !state.labels) return;
+  if (lastHover && lastHover.face < 0 && !picks.busy) return;
+  message('');
   orbit.enabled = false;
   painting = true;
-  paint(hit);
+  strokeCount += 1;
+  submitPick(event, true);
+}, { capture: true });
+view.renderer.domElement.addEventListener('pointermove', (event) => {
+  if (painting) submitPick(event, true);
+  else if (state.tool !== 'orbit' && state.labels && !gizmo.dragging && event.buttons === 0) submitPick(event, false);
 });
-renderer.domElement.addEventListener('pointermove', (event) => {
-  if (!painting) return;
-  const hit = hitAt(event);
-  if (hit) paint(hit);
-});
+view.renderer.domElement.addEventListener('pointerleave', () => { if (!painting) view.hideCursor(); });
 window.addEventListener('pointerup', () => {
   if (!painting) return;
   painting = false;
   orbit.enabled = true;
-  if (state.dirtyRegion) task(sendRegion);
+  state.marks.strokeEnd = performance.now();
+  task(async () => {
+    await picks.idle();
+    if (state.dirtyRegion) await sendRegion();
+  });
 });
 
+/// The painted region as the API takes it; handles are renumbered so that none is empty (the
+/// labels follow), and `free` counts the support's vertices outside every handle.
 function regionLists() {
-  const support = [], handles = Array.from({ length: state.handleCount }, () => []);
+  const counts = new Array(state.handleCount).fill(0);
+  let free = 0;
+  for (const l of state.labels) if (l >= 0) counts[l] += 1; else if (l === FREE) free += 1;
+  const renumber = [];
+  counts.forEach((c, j) => { renumber[j] = c > 0 ? renumber.filter((x) => x >= 0).length : -1; });
+  const kept = renumber.filter((x) => x >= 0).length;
+  const support = [], handles = Array.from({ length: kept }, () => []);
   for (let v = 0; v < state.labels.length; ++v) {
     const l = state.labels[v];
     if (l === FIXED) continue;
     support.push(v);
-    if (l >= 0) handles[l].push(v);
+    if (l >= 0) { state.labels[v] = renumber[l]; handles[renumber[l]].push(v); }
   }
-  return { support, handles: handles.filter((h) => h.length > 0) };
+  if (renumber.some((x, j) => x !== j)) view.colour(state.labels);
+  if (kept > 0) {
+    state.selected = renumber[state.selected] >= 0 ? renumber[state.selected] : kept - 1;
+    state.handleCount = kept;
+  }
+  return { support, handles, free };
 }
 
-async function sendRegion() {
-  const { support, handles } = regionLists();
+/// Sends the painted region when it can be solved; otherwise says what is missing. A refusal
+/// (a 4xx or the job's error) keeps the paint and shows the server's message.
+async function sendRegion({ keepGizmo = false } = {}) {
   state.dirtyRegion = false;
-  if (!support.length || !handles.length) {
-    message(support.length ? 'Now paint a handle inside the support (tool "Handle").'
-                           : 'Paint a support, then a handle inside it.', 'info');
+  const { support, handles, free } = regionLists();
+  showHandleButtons();
+  if (!handles.length) {
+    message(support.length ? 'Now paint a handle inside the support (tool "Handle", H).'
+                           : 'Paint a support (S), then a handle inside it (H).', 'hint');
     return;
   }
+  if (!free) {
+    message('The support has no free vertex: paint the support around the handle (tool "Support", S).', 'hint');
+    return;
+  }
+  if (busy()) await settle();
   try {
-    await post('region', { support, handles, k: state.k });
-    await fetchMesh(false);
-    message('Drag the arrows to move the handle.', 'info');
-  } catch (e) { /* shown */ }
+    panels.showProgress(await (await post('region', { support, handles, k: state.k })).json());
+  } catch (e) { return; }
+  const s = await settle();
+  if (s.error) {
+    state.status = s;
+    panels.showStats(s, state.frameMs);
+    state.dirtyRegion = true;
+    placeGizmo(true);
+    return;
+  }
+  await sync(s, { labelsKnown: true, keepGizmo });
+  state.marks.regionReady.push(performance.now());
+  if (!keepGizmo) {
+    setTool('orbit');
+    message('Region ready; the Orbit tool is on: drag the arrows to move the handle (S, H: paint again).', 'info');
+  }
 }
 
 // ---- handles and the manipulator ----------------------------------------------------------------
-function updateHandleButtons() {
-  const box = $('handles');
-  box.innerHTML = '';
-  for (let j = 0; j < state.handleCount; ++j) {
-    const b = document.createElement('button');
-    b.textContent = `H${j + 1}`;
-    const [r, g, bl] = HANDLE_COLORS[j % HANDLE_COLORS.length];
-    b.style.borderColor = `rgb(${255 * r},${255 * g},${255 * bl})`;
-    b.className = j === state.selected ? 'active' : '';
-    b.onclick = () => { state.selected = j; updateHandleButtons(); placeGizmo(); };
-    box.appendChild(b);
-  }
+function showHandleButtons() {
+  panels.showHandles(state.handleCount, state.selected, (j) => { state.selected = j; showHandleButtons(); placeGizmo(); });
 }
 
 function handleCentre(j) {
@@ -358,14 +234,20 @@ function handleCentre(j) {
   return count ? c.divideScalar(count) : null;
 }
 
-function placeGizmo() {
-  const centre = state.movable && state.labels ? handleCentre(state.selected) : null;
-  if (!centre || !showUi) { gizmo.detach(); return; }
+/// The manipulator is shown, and takes the mouse, only with the Orbit tool, for a handle the
+/// server holds, while the server is idle. keep: leave an attached manipulator where it is.
+function placeGizmo(keep = false) {
+  const wanted = showUi && state.tool === 'orbit' && !!state.movable && !!state.labels && !busy() &&
+                 state.selected < state.serverHandles;
+  if (!wanted) { view.showGizmo(false); return; }
+  if (keep && view.gizmoPlaced()) { view.showGizmo(true); return; }
+  const centre = handleCentre(state.selected);
+  if (!centre) { view.showGizmo(false); return; }
   pivot.position.copy(centre);
   pivot.quaternion.identity();
   pivot.scale.set(1, 1, 1);
   pivot.updateMatrix();
-  gizmo.attach(pivot);
+  view.showGizmo(true);
 }
 
 function rowsToMatrix(rows) {
@@ -379,204 +261,122 @@ function matrixToRows(m) {
   return [e[0], e[4], e[8], e[12], e[1], e[5], e[9], e[13], e[2], e[6], e[10], e[14]];
 }
 
-let dragStart = null, dragBase = null, inFlight = false, pending = null;
-gizmo.addEventListener('dragging-changed', async (event) => {
+async function sendFrame(request) {
+  const response = await api('transform', { method: 'POST', headers: { 'Content-Type': 'application/json' },
+                                            body: JSON.stringify({ handle: request.handle, matrix: request.matrix }) });
+  const buffer = await response.arrayBuffer();
+  return { moved: new Float32Array(buffer), bytes: buffer.byteLength, ms: parseFloat(response.headers.get('X-Frame-Ms')) };
+}
+const frames = new Coalescer(sendFrame, (result, request) => {
+  if (!state.movable || result.moved.length !== 3 * state.movable.length) return;
+  state.frameMs = result.ms;
+  view.applyMoved(state.movable, result.moved);
+  state.marks.drag.push(performance.now() - request.t0);
+  state.marks.dragBytes.push(result.bytes);
+});
+
+let dragStart = null, dragBase = null;
+gizmo.addEventListener('dragging-changed', (event) => {
   orbit.enabled = !event.value;
   if (event.value) {
     pivot.updateMatrix();
     dragStart = pivot.matrix.clone().invert();
     dragBase = (state.transforms[state.selected] || new THREE.Matrix4()).clone();
-  } else {
-    dragStart = null;
-    await task(async () => {
-      await flush();
-      try { await post('commit'); state.status = await json('status'); showStats(); } catch (e) { /* shown */ }
-      if (baseShown()) await showBase(false);
-    });
+    return;
   }
+  dragStart = null;
+  task(async () => {
+    await frames.idle();
+    try { await post('commit'); state.status = await json('status'); panels.showStats(state.status, state.frameMs); } catch (e) { /* shown */ }
+    if (baseShown()) await showBase(false);
+  });
 });
 gizmo.addEventListener('objectChange', () => {
   if (!dragStart) return;
+  // Through the pivot the scale would flip sign: the map must keep its orientation (det > 0).
+  for (const axis of ['x', 'y', 'z']) pivot.scale[axis] = Math.max(MIN_SCALE, pivot.scale[axis]);
   pivot.updateMatrix();
-  const delta = pivot.matrix.clone().multiply(dragStart);
-  const t = delta.multiply(dragBase);
+  const t = pivot.matrix.clone().multiply(dragStart).multiply(dragBase);
   state.transforms[state.selected] = t;
-  pending = { handle: state.selected, matrix: matrixToRows(t) };
-  if (!inFlight) flush();
+  frames.submit({ handle: state.selected, matrix: matrixToRows(t), t0: performance.now() });
 });
 
-async function flush() {
-  while (pending && !inFlight) {
-    const request = pending;
-    pending = null;
-    inFlight = true;
-    try {
-      const response = await api('transform', { method: 'POST', headers: { 'Content-Type': 'application/json' },
-                                                  body: JSON.stringify(request) });
-      const moved = new Float32Array(await response.arrayBuffer());
-      state.frameMs = parseFloat(response.headers.get('X-Frame-Ms'));
-      applyMoved(moved);
-    } catch (e) { /* shown */ }
-    inFlight = false;
-  }
-}
-
-function applyMoved(moved) {
-  const p = state.positions, ids = state.movable;
-  for (let i = 0; i < ids.length; ++i) {
-    const v = ids[i];
-    p[3 * v] = moved[3 * i]; p[3 * v + 1] = moved[3 * i + 1]; p[3 * v + 2] = moved[3 * i + 2];
-  }
-  const g = mesh.geometry;
-  g.getAttribute('position').needsUpdate = true;
-  g.computeVertexNormals();
-  g.computeBoundingSphere();
-}
-
-// ---- the base surface: shaded, and as a wireframe coloured by vertex area -----------------------
-let baseSurface = null;
+// ---- the base surface ---------------------------------------------------------------------------
 const baseShown = () => $('show-base').checked || $('show-wire').checked;
+/// Draws the base when a checkbox asks for it: its faces and areas again when `refetchIndices`
+/// (a new mesh or region), otherwise its current positions.
 async function showBase(refetchIndices) {
-  if (!baseShown()) {
-    if (baseLines) baseLines.visible = false;
-    if (baseSurface) baseSurface.visible = false;
-    return;
+  if (baseShown() && state.status?.state === 'ready') {
+    const positions = await binary('base/positions', Float32Array);
+    if (refetchIndices || !view.hasBase())
+      view.setBase(positions, await binary('base/indices', Uint32Array), await binary('base/areas', Float32Array), areaRange);
+    else view.setBase(positions, null);
   }
-  const positions = await binary('base/positions', Float32Array);
-  if (!baseLines || refetchIndices) {
-    const indices = await binary('base/indices', Uint32Array);
-    const areas = await binary('base/areas', Float32Array);
-    const colours = new Float32Array(3 * areas.length);
-    for (let v = 0; v < areas.length; ++v) {
-      // Blue below the mean area, white at it, red above: ±20 % saturates (area-range= in the URL).
-      const t = Math.max(-1, Math.min(1, (areas[v] - 1) / areaRange));
-      colours[3 * v] = t > 0 ? 1 : 1 + t; colours[3 * v + 1] = 1 - Math.abs(t); colours[3 * v + 2] = t < 0 ? 1 : 1 - t;
-    }
-    const geometry = new THREE.BufferGeometry();
-    geometry.setAttribute('position', new THREE.BufferAttribute(positions, 3));
-    geometry.setAttribute('color', new THREE.BufferAttribute(colours, 3));
-    geometry.setIndex(new THREE.BufferAttribute(indices, 1));
-    geometry.computeVertexNormals();
-    for (const old of [baseLines, baseSurface]) if (old) scene.remove(old);
-    if (baseLines) baseLines.geometry.dispose();
-    baseLines = new THREE.Mesh(geometry, new THREE.MeshBasicMaterial({ vertexColors: true, wireframe: true }));
-    baseSurface = new THREE.Mesh(geometry, new THREE.MeshStandardMaterial({
-      color: 0x8fb0d8, roughness: 0.6, side: THREE.DoubleSide,
-      polygonOffset: true, polygonOffsetFactor: 1, polygonOffsetUnits: 1 }));
-    scene.add(baseSurface);
-    scene.add(baseLines);
-  } else {
-    const attribute = baseLines.geometry.getAttribute('position');
-    attribute.array.set(positions);
-    attribute.needsUpdate = true;
-    baseLines.geometry.computeVertexNormals();
-  }
-  baseLines.visible = $('show-wire').checked;
-  baseSurface.visible = $('show-base').checked;
+  view.showBase($('show-base').checked, $('show-wire').checked);
 }
+const showMesh = () => view.showMesh($('show-mesh').checked, $('show-edges').checked);
 
-// ---- stats --------------------------------------------------------------------------------------
-function showStats() {
-  const s = state.status;
-  if (!s) return;
-  const lines = [];
-  if (s.mesh) lines.push(`${s.mesh.name}`, `${s.mesh.vertices.toLocaleString()} vertices, ${s.mesh.faces.toLocaleString()} faces`);
-  if (s.base) {
-    lines.push(`base: ${s.base.vertices.toLocaleString()} vertices (remeshed)`);
-    lines.push(`preprocessing ${(s.base.preprocess_ms / 1000).toFixed(2)} s`);
-    lines.push(`area spread (rel MAD) ${s.base.area_rel_mad.toFixed(3)}, smallest angle ${s.base.min_angle_deg.toFixed(1)}°`);
-  }
-  if (s.region) {
-    lines.push(`support ${s.region.support.toLocaleString()} vertices, ${s.region.handles} handle(s), k = ${s.region.k}`);
-    lines.push(`set_region ${s.region.set_region_ms.toFixed(0)} ms, frame ${(state.frameMs ?? s.frame_ms).toFixed(1)} ms`);
-  }
-  $('stats').textContent = lines.join('\n');
-  $('undo').disabled = !s.undo;
-  $('redo').disabled = !s.redo;
-}
-
-// ---- controls -----------------------------------------------------------------------------------
+// ---- actions of the panel and the keyboard ------------------------------------------------------
 function setTool(tool) {
   state.tool = tool;
-  for (const b of document.querySelectorAll('#tools button')) b.classList.toggle('active', b.dataset.tool === tool);
+  panels.setToolButtons(tool);
+  if (tool === 'orbit') view.hideCursor();
+  placeGizmo(true);
 }
-for (const b of document.querySelectorAll('#tools button')) b.onclick = () => setTool(b.dataset.tool);
 function setMode(mode) {
   gizmo.setMode(mode);
-  for (const b of document.querySelectorAll('#modes button')) b.classList.toggle('active', b.dataset.mode === mode);
+  panels.setModeButtons(mode);
 }
-for (const b of document.querySelectorAll('#modes button')) b.onclick = () => setMode(b.dataset.mode);
-$('radius').oninput = () => { $('radius-value').textContent = $('radius').value; };
-$('new-handle').onclick = () => {
-  state.handleCount += 1; state.selected = state.handleCount - 1; setTool('handle'); updateHandleButtons();
-};
-$('clear').onclick = () => {
+function newHandle() {
+  state.handleCount += 1;
+  state.selected = state.handleCount - 1;
+  setTool('handle');
+  showHandleButtons();
+  placeGizmo();
+}
+function clear() {
   if (!state.labels) return;
-  state.labels.fill(FIXED); state.handleCount = 1; state.selected = 0; recolour(); updateHandleButtons(); gizmo.detach();
-};
-$('k').onchange = () => { state.k = parseInt($('k').value, 10); if (state.movable) task(sendRegion); };
+  state.labels.fill(FIXED);
+  state.handleCount = 1;
+  state.selected = 0;
+  view.colour(state.labels);
+  showHandleButtons();
+  view.detachGizmo();
+}
+function setK(k) {
+  state.k = k;
+  if (state.movable && state.labels && !painting) task(() => sendRegion({ keepGizmo: true }));
+}
 async function history(which) {
-  try {
-    await post(which);
-    await fetchMesh(false);
-  } catch (e) { /* shown */ }
+  if (busy() || frames.busy || painting) return;
+  message('');
+  try { await post(which); } catch (e) { return; }
+  await sync(await settle());
 }
-$('undo').onclick = () => task(() => history('undo'));
-$('redo').onclick = () => task(() => history('redo'));
-$('show-base').onchange = () => task(() => showBase(false));
-$('show-wire').onchange = () => task(() => showBase(false));
-function showMesh() {
-  if (!mesh) return;
-  mesh.visible = $('show-mesh').checked;
-  edges.visible = $('show-edges').checked;
-}
-$('show-mesh').onchange = showMesh;
-$('show-edges').onchange = showMesh;
-window.addEventListener('keydown', (event) => {
-  if (event.target.tagName === 'INPUT') return;
-  const key = event.key.toLowerCase();
-  if ((event.ctrlKey || event.metaKey) && key === 'z') { event.preventDefault(); task(() => history(event.shiftKey ? 'redo' : 'undo')); return; }
-  if (event.ctrlKey || event.metaKey) return;
-  if (key === 'w') setMode('translate');
-  if (key === 'e') setMode('rotate');
-  if (key === 'r') setMode('scale');
-  if (key === 'o') setTool('orbit');
-  if (key === 's') setTool('support');
-  if (key === 'h') setTool('handle');
-  if (key === 'x') setTool('erase');
-});
-
-// ---- loading ------------------------------------------------------------------------------------
 async function upload(file) {
   message('');
   try {
     await api(`load?name=${encodeURIComponent(file.name)}`, { method: 'POST', body: await file.arrayBuffer() });
-    const s = await waitUntilReady();
-    if (s.error) return;
-    state.selected = 0;
-    await fetchMesh(true);
-    message(`Loaded ${file.name}. Paint a support, then a handle.`, 'info');
-  } catch (e) { /* shown */ }
+  } catch (e) { return; }
+  const s = await settle();
+  if (s.error) { state.status = s; panels.showStats(s); return; }
+  state.selected = 0;
+  await sync(s, { fit: true });
+  message(`Loaded ${file.name}. Paint a support (S), then a handle inside it (H).`, 'info');
 }
-$('file').onchange = (event) => { if (event.target.files[0]) task(() => upload(event.target.files[0])); };
-view.addEventListener('dragover', (event) => event.preventDefault());
-view.addEventListener('drop', (event) => {
-  event.preventDefault();
-  if (event.dataTransfer.files[0]) task(() => upload(event.dataTransfer.files[0]));
+panels.bindPanels({
+  setTool, setMode, newHandle, clear, setK, showMesh,
+  history: (which) => task(() => history(which)),
+  showBase: () => task(() => showBase(false)),
+  upload: (file) => task(() => upload(file)),
+  scaleRadius: (factor) => { panels.scaleRadius(factor); view.setCursorRadius(panels.radius()); },
+  meshName: () => state.status?.mesh?.name,
 });
 
-// ---- for the end-to-end test: where a vertex is on screen, and the page's state ------------------
+// ---- for the tests and the benchmark: where things are on screen, and the page's state ----------
 window.remora = {
-  project(v) {
-    const rect = renderer.domElement.getBoundingClientRect();
-    const p = new THREE.Vector3(state.positions[3 * v], state.positions[3 * v + 1], state.positions[3 * v + 2]).project(camera);
-    return { x: rect.left + (p.x + 1) / 2 * rect.width, y: rect.top + (1 - p.y) / 2 * rect.height };
-  },
-  projectPoint(x, y, z) {
-    const rect = renderer.domElement.getBoundingClientRect();
-    const p = new THREE.Vector3(x, y, z).project(camera);
-    return { x: rect.left + (p.x + 1) / 2 * rect.width, y: rect.top + (1 - p.y) / 2 * rect.height };
-  },
+  project: (v) => view.project(state.positions[3 * v], state.positions[3 * v + 1], state.positions[3 * v + 2]),
+  projectPoint: (x, y, z) => view.project(x, y, z),
   nearest(x, y, z) {
     let best = -1, bestD = Infinity;
     const p = state.positions;
@@ -586,24 +386,40 @@ window.remora = {
     }
     return best;
   },
-  setRadius(r) { $('radius').value = r; $('radius-value').textContent = String(r); },
+  setRadius: (r) => panels.setRadius(r),
+  radius: () => panels.radius(),
   pivot: () => pivot.position.toArray(),
-  camera: () => camera.position.toArray(),
-  shown: () => ({ mesh: !!mesh?.visible, edges: !!edges?.visible, base: !!baseSurface?.visible,
-                  wire: !!baseLines?.visible, manipulator: !!gizmo.object }),
+  camera: () => view.camera.position.toArray(),
+  shown: () => ({ mesh: !!view.shown.mesh?.visible, edges: !!view.shown.edges?.visible, base: !!view.shown.baseSurface?.visible,
+                  wire: !!view.shown.baseLines?.visible, manipulator: !!gizmo.object && gizmo.enabled && view.gizmoHelper.visible,
+                  cursor: view.cursorShown(), cursorRadius: view.cursorRadius() }),
   labels: () => Array.from(state.labels ?? []),
-  ready: () => !!mesh && state.tasks === 0 && !inFlight && !pending && state.status?.state === 'ready',
+  positionsHeld: () => state.positions,
+  tool: () => state.tool,
+  selected: () => state.selected,
+  /// The largest difference between the page's normals and three.js's full computeVertexNormals().
+  normalError() {
+    const a = view.normals(), b = view.referenceNormals();
+    let worst = 0;
+    for (let i = 0; i < a.length; ++i) worst = Math.max(worst, Math.abs(a[i] - b[i]));
+    return worst;
+  },
+  marks: () => JSON.parse(JSON.stringify(state.marks)),
+  ready: () => !!view.shown.mesh && work.tasks === 0 && !frames.busy && !picks.busy && state.status?.state === 'ready',
   setTool, setMode,
 };
 
 task(async () => {
   try {
-    const s = await waitUntilReady();
+    const s = await settle();
     if (s.state === 'ready') {
-      await fetchMesh(true);
+      await sync(s, { fit: true });
+      state.marks.paintable = performance.now();
       message('Paint a support (S), then a handle inside it (H); drag the arrows.', 'info');
     } else {
       message('Open a mesh (or drop one here) to start.', 'info');
     }
-  } catch (e) { /* shown */ }
+  } catch (e) {
+    if (!(e instanceof ApiError)) message(`the page failed: ${e.message}`);
+  }
 });

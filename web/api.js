@@ -1,0 +1,69 @@
+// The page's side of the HTTP API (docs/server.md): a fetch wrapper whose failures reach the
+// message box, the status poll with its progress bar, and the count of work under way.
+const $ = (id) => document.getElementById(id);
+
+/// Requests and refreshes under way; the tests wait until it is 0.
+export const work = { tasks: 0 };
+
+/// Runs an asynchronous piece of work, counted in work.tasks.
+export async function task(job) {
+  work.tasks += 1;
+  try { return await job(); } finally { work.tasks -= 1; }
+}
+
+/// Shows `text` at the bottom of the view. kind 'error' stays until replaced or cleared; 'hint'
+/// stays until replaced; 'info' hides itself after 2.5 s. An info or hint never replaces an
+/// error that is shown: message('') clears it first (a new user action does so).
+export function message(text, kind = 'error') {
+  const box = $('message');
+  if (text && kind !== 'error' && !box.hidden && box.className === 'error') return;
+  box.textContent = text;
+  box.className = kind;
+  box.hidden = !text;
+  if (kind === 'info' && text) setTimeout(() => { if (box.textContent === text) box.hidden = true; }, 2500);
+}
+export const shownError = () => (!$('message').hidden && $('message').className === 'error'
+  ? $('message').textContent : '');
+
+/// An answer other than 2xx: its HTTP status and the server's message.
+export class ApiError extends Error {
+  constructor(status, text) { super(text); this.status = status; }
+}
+
+/// fetch('api/' + path); a refusal shows the server's message (its JSON "error") and throws
+/// ApiError; a server that does not answer throws with a message that says so.
+export async function api(path, options = {}) {
+  let response;
+  try {
+    response = await fetch('api/' + path, options);
+  } catch (e) {
+    const text = `the server does not answer (${e.message}); is remora serve still running?`;
+    message(text);
+    throw new ApiError(0, text);
+  }
+  if (!response.ok) {
+    let text = `${response.status} ${response.statusText}`;
+    try { text = (await response.json()).error || text; } catch (e) { /* not JSON */ }
+    message(text);
+    throw new ApiError(response.status, text);
+  }
+  return response;
+}
+export const json = async (path, options) => (await api(path, options)).json();
+export const binary = async (path, Type) => new Type(await (await api(path)).arrayBuffer());
+export const post = (path, body) => api(path, { method: 'POST', headers: { 'Content-Type': 'application/json' },
+                                                body: JSON.stringify(body ?? {}) });
+
+/// Polls the status until the server is not busy; calls onBusy(status) on every busy answer and
+/// returns the first other status. A job's error (status.error) is shown.
+export async function waitUntilReady(onBusy) {
+  for (;;) {
+    const s = await json('status');
+    if (s.state !== 'busy') {
+      if (s.error) message(s.error);
+      return s;
+    }
+    onBusy(s);
+    await new Promise((r) => setTimeout(r, 150));
+  }
+}

@@ -1,0 +1,262 @@
+// What the page draws: the renderer, camera and lights, the orbit controls and the manipulator,
+// the edited mesh (its colours, its normals kept current during a drag), the remeshed base and the
+// brush cursor. Holds the three.js objects; the state of the edit lives in app.js.
+import * as THREE from 'three';
+import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
+import { TransformControls } from 'three/addons/controls/TransformControls.js';
+import { normalPlan, updateNormals } from './normals.js';
+
+export const FIXED = -2, FREE = -1;
+export const HANDLE_COLORS = [[0.90, 0.30, 0.25], [0.25, 0.55, 0.95], [0.30, 0.80, 0.40], [0.85, 0.45, 0.90],
+                              [0.95, 0.60, 0.20], [0.20, 0.80, 0.80]];
+const FIXED_RGB = [0.78, 0.78, 0.78], FREE_RGB = [0.96, 0.86, 0.45];
+export const labelColour = (l) => (l === FIXED ? FIXED_RGB : l === FREE ? FREE_RGB : HANDLE_COLORS[l % HANDLE_COLORS.length]);
+
+export const container = document.getElementById('view');
+export const renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
+renderer.setPixelRatio(window.devicePixelRatio);
+container.appendChild(renderer.domElement);
+export const scene = new THREE.Scene();
+scene.background = new THREE.Color(0x20242a);
+export const camera = new THREE.PerspectiveCamera(40, 1, 0.001, 1000);
+scene.add(camera);
+// A headlight and a grazing key light: surface detail shows as shading.
+scene.add(new THREE.HemisphereLight(0xffffff, 0x404048, 0.9));
+const key = new THREE.DirectionalLight(0xffffff, 1.6);
+key.position.set(-1, 1.5, 1);
+camera.add(key);
+
+/// The camera's up must be set before the orbit controls exist (they orbit about the up they find).
+export let orbit = null;
+export let gizmo = null, gizmoHelper = null;
+export const pivot = new THREE.Object3D();
+export function createControls(up) {
+  if (up) camera.up.fromArray(up).normalize();
+  orbit = new OrbitControls(camera, renderer.domElement);
+  orbit.enableDamping = false;
+  gizmo = new TransformControls(camera, renderer.domElement);
+  scene.add(pivot);
+  gizmoHelper = gizmo.getHelper ? gizmo.getHelper() : gizmo;
+  scene.add(gizmoHelper);
+  showGizmo(false);
+}
+/// Shows the manipulator on the pivot and lets it take the mouse, or hides and disables it (it
+/// stays attached, so that showing it again keeps its place and orientation).
+export function showGizmo(on) {
+  if (on && gizmo.object !== pivot) gizmo.attach(pivot);
+  gizmo.enabled = on;
+  gizmoHelper.visible = on;
+}
+export const gizmoPlaced = () => gizmo.object === pivot;
+/// Forgets the manipulator's place (a new region or handle places it again).
+export function detachGizmo() { gizmo.detach(); showGizmo(false); }
+
+// The surface sits a little behind its own wireframe (show-edges), which shares its geometry.
+const material = new THREE.MeshStandardMaterial({ vertexColors: true, roughness: 0.75, metalness: 0.0,
+                                                  side: THREE.DoubleSide,
+                                                  polygonOffset: true, polygonOffsetFactor: 1, polygonOffsetUnits: 1 });
+const edgeMaterial = new THREE.MeshBasicMaterial({ color: 0x30343c, wireframe: true });
+/// The drawn objects (null until there is something to draw).
+export const shown = { mesh: null, edges: null, baseLines: null, baseSurface: null };
+let plan = null; // normalPlan() of the current movable vertices
+
+function resize() {
+  const w = container.clientWidth, h = container.clientHeight;
+  renderer.setSize(w, h);
+  camera.aspect = w / Math.max(h, 1);
+  camera.updateProjectionMatrix();
+}
+new ResizeObserver(resize).observe(container); // the window, and the panel shown or hidden (ui=0)
+resize();
+// Attribute changes since the last frame: attribute -> { lo, hi } (a vertex range) or null (all),
+// uploaded once per frame, so that several changes between two frames are all kept.
+const touched = new Map();
+function touch(attribute, lo = null, hi = null) {
+  const old = touched.get(attribute);
+  if (lo === null || old === null) { touched.set(attribute, null); return; }
+  touched.set(attribute, old ? { lo: Math.min(old.lo, lo), hi: Math.max(old.hi, hi) } : { lo, hi });
+}
+renderer.setAnimationLoop(() => {
+  for (const [attribute, range] of touched) {
+    attribute.clearUpdateRanges();
+    if (range) attribute.addUpdateRange(attribute.itemSize * range.lo, attribute.itemSize * (range.hi - range.lo + 1));
+    attribute.needsUpdate = true;
+  }
+  touched.clear();
+  renderer.render(scene, camera);
+});
+
+/// Draws a new mesh: positions (Float32 x, y, z per vertex) and indices (Uint32 triples) are held,
+/// not copied. The bounding sphere is computed here once; the mesh is never frustum-culled, so a
+/// drag needs no new bounds.
+export function setMesh(positions, indices) {
+  const n = positions.length / 3;
+  const geometry = new THREE.BufferGeometry();
+  geometry.setAttribute('position', new THREE.BufferAttribute(positions, 3));
+  geometry.setAttribute('color', new THREE.BufferAttribute(new Float32Array(3 * n), 3));
+  geometry.setIndex(new THREE.BufferAttribute(indices, 1));
+  geometry.computeVertexNormals();
+  geometry.computeBoundingSphere();
+  if (shown.mesh) { scene.remove(shown.mesh); scene.remove(shown.edges); shown.mesh.geometry.dispose(); }
+  shown.mesh = new THREE.Mesh(geometry, material);
+  shown.edges = new THREE.Mesh(geometry, edgeMaterial);
+  shown.mesh.frustumCulled = false;
+  shown.edges.frustumCulled = false;
+  scene.add(shown.mesh);
+  scene.add(shown.edges);
+  plan = null;
+}
+
+/// Every position changed (undo, redo, a new k): positions.set() was called on the held array.
+export function positionsChanged() {
+  const g = shown.mesh.geometry;
+  touch(g.getAttribute('position'));
+  g.computeVertexNormals();
+  touch(g.getAttribute('normal'));
+}
+
+/// Prepares applyMoved() for a region's movable vertices (once per region).
+export function setMovable(movable) {
+  const g = shown.mesh.geometry;
+  plan = movable ? normalPlan(g.getIndex().array, g.getAttribute('position').count, movable) : null;
+}
+
+/// A drag's frame: moved holds x, y, z for each of movable (setMovable's ids, in that order).
+/// Recomputes the normals that can change and uploads only the range that holds them.
+export function applyMoved(movable, moved) {
+  const g = shown.mesh.geometry;
+  const position = g.getAttribute('position'), normal = g.getAttribute('normal');
+  const p = position.array;
+  for (let i = 0; i < movable.length; ++i) {
+    const v = movable[i];
+    p[3 * v] = moved[3 * i]; p[3 * v + 1] = moved[3 * i + 1]; p[3 * v + 2] = moved[3 * i + 2];
+  }
+  updateNormals(p, g.getIndex().array, normal.array, plan);
+  if (plan.last < plan.first) return;
+  touch(position, plan.first, plan.last);
+  touch(normal, plan.first, plan.last);
+}
+
+/// The full recomputation (three.js's), for the test that compares it with applyMoved's normals.
+export function referenceNormals() {
+  const g = shown.mesh.geometry.clone();
+  g.deleteAttribute('normal');
+  g.computeVertexNormals();
+  return g.getAttribute('normal').array;
+}
+export const normals = () => shown.mesh.geometry.getAttribute('normal').array;
+
+/// Colours every vertex by its label (FIXED, FREE, or a handle index), or only the vertices `ids`.
+export function colour(labels, ids = null) {
+  const colours = shown.mesh.geometry.getAttribute('color');
+  const c = colours.array;
+  const set = (v) => { const rgb = labelColour(labels[v]); c[3 * v] = rgb[0]; c[3 * v + 1] = rgb[1]; c[3 * v + 2] = rgb[2]; };
+  if (ids) {
+    let lo = Infinity, hi = -1;
+    for (const v of ids) { set(v); lo = Math.min(lo, v); hi = Math.max(hi, v); }
+    if (hi >= 0) touch(colours, lo, hi);
+  } else {
+    for (let v = 0; v < labels.length; ++v) set(v);
+    touch(colours);
+  }
+}
+
+/// Places the camera to see the whole mesh, or at cameraParam (px,py,pz,tx,ty,tz[,up]); returns
+/// the bounding sphere's radius.
+export function fitCamera(cameraParam) {
+  const sphere = shown.mesh.geometry.boundingSphere;
+  orbit.target.copy(sphere.center);
+  camera.near = sphere.radius / 100;
+  camera.far = sphere.radius * 100;
+  camera.position.copy(sphere.center).add(new THREE.Vector3(0, 0, sphere.radius * 2.8));
+  if (cameraParam) {
+    camera.position.fromArray(cameraParam, 0);
+    orbit.target.fromArray(cameraParam, 3);
+  }
+  camera.updateProjectionMatrix();
+  orbit.update();
+  return sphere.radius;
+}
+
+export function showMesh(mesh, edges) {
+  if (!shown.mesh) return;
+  shown.mesh.visible = mesh;
+  shown.edges.visible = edges;
+}
+
+/// The world-space ray under a pointer event: { origin: [x, y, z], direction: [x, y, z] }.
+const raycaster = new THREE.Raycaster();
+export function rayAt(event) {
+  const rect = renderer.domElement.getBoundingClientRect();
+  const ndc = new THREE.Vector2(((event.clientX - rect.left) / rect.width) * 2 - 1,
+                                -((event.clientY - rect.top) / rect.height) * 2 + 1);
+  raycaster.setFromCamera(ndc, camera);
+  return { origin: raycaster.ray.origin.toArray(), direction: raycaster.ray.direction.toArray() };
+}
+
+/// Where a world point is on screen, in client pixels.
+export function project(x, y, z) {
+  const rect = renderer.domElement.getBoundingClientRect();
+  const p = new THREE.Vector3(x, y, z).project(camera);
+  return { x: rect.left + (p.x + 1) / 2 * rect.width, y: rect.top + (1 - p.y) / 2 * rect.height };
+}
+
+// ---- the base surface: shaded, and as a wireframe coloured by vertex area -----------------------
+/// Draws the base: new faces and areas (areas / mean area, coloured blue below 1, white at 1, red
+/// above, saturating at ±areaRange) or, with indices null, new positions for the same faces.
+export function setBase(positions, indices, areas, areaRange) {
+  if (!indices) {
+    const attribute = shown.baseLines.geometry.getAttribute('position');
+    attribute.array.set(positions);
+    touch(attribute);
+    shown.baseLines.geometry.computeVertexNormals();
+    touch(shown.baseLines.geometry.getAttribute('normal'));
+    return;
+  }
+  const colours = new Float32Array(3 * areas.length);
+  for (let v = 0; v < areas.length; ++v) {
+    const t = Math.max(-1, Math.min(1, (areas[v] - 1) / areaRange));
+    colours[3 * v] = t > 0 ? 1 : 1 + t; colours[3 * v + 1] = 1 - Math.abs(t); colours[3 * v + 2] = t < 0 ? 1 : 1 - t;
+  }
+  const geometry = new THREE.BufferGeometry();
+  geometry.setAttribute('position', new THREE.BufferAttribute(positions, 3));
+  geometry.setAttribute('color', new THREE.BufferAttribute(colours, 3));
+  geometry.setIndex(new THREE.BufferAttribute(indices, 1));
+  geometry.computeVertexNormals();
+  for (const old of [shown.baseLines, shown.baseSurface]) if (old) scene.remove(old);
+  if (shown.baseLines) shown.baseLines.geometry.dispose();
+  shown.baseLines = new THREE.Mesh(geometry, new THREE.MeshBasicMaterial({ vertexColors: true, wireframe: true }));
+  shown.baseSurface = new THREE.Mesh(geometry, new THREE.MeshStandardMaterial({
+    color: 0x8fb0d8, roughness: 0.6, side: THREE.DoubleSide,
+    polygonOffset: true, polygonOffsetFactor: 1, polygonOffsetUnits: 1 }));
+  scene.add(shown.baseSurface);
+  scene.add(shown.baseLines);
+}
+export const hasBase = () => !!shown.baseLines;
+export function showBase(surface, wire) {
+  if (shown.baseLines) shown.baseLines.visible = wire;
+  if (shown.baseSurface) shown.baseSurface.visible = surface;
+}
+
+// ---- the brush cursor: a ring of the brush's radius on the surface under the pointer ------------
+const ringPoints = Array.from({ length: 64 }, (_, i) =>
+  new THREE.Vector3(Math.cos(i / 32 * Math.PI), Math.sin(i / 32 * Math.PI), 0));
+const cursor = new THREE.LineLoop(new THREE.BufferGeometry().setFromPoints(ringPoints),
+                                  new THREE.LineBasicMaterial({ color: 0xffffff, depthTest: false, transparent: true, opacity: 0.85 }));
+cursor.renderOrder = 10;
+cursor.visible = false;
+cursor.frustumCulled = false;
+scene.add(cursor);
+const zAxis = new THREE.Vector3(0, 0, 1);
+/// Shows the ring at point (x, y, z) in the plane normal to `normal`, of the given radius.
+export function showCursor(point, normal, radius) {
+  cursor.position.fromArray(point);
+  const n = new THREE.Vector3().fromArray(normal);
+  if (n.lengthSq() > 0) cursor.quaternion.setFromUnitVectors(zAxis, n.normalize());
+  cursor.scale.setScalar(Math.max(radius, 1e-9));
+  cursor.visible = true;
+}
+export function setCursorRadius(radius) { cursor.scale.setScalar(Math.max(radius, 1e-9)); }
+export function hideCursor() { cursor.visible = false; }
+export const cursorShown = () => cursor.visible;
+export const cursorRadius = () => (cursor.visible ? cursor.scale.x : 0);
