@@ -1,105 +1,100 @@
-// End to end, in a real browser: `remora serve` on the bundled bunny, Debian's chromium driven by
+// End to end, in a real browser: `remora serve` on a mesh, Debian's chromium driven by
 // playwright-core. Paints a support and a handle with mouse events, drags the manipulator, and
 // checks through the API that the handle moved by the dragged amount, that nothing outside the
-// support moved, and that undo restores the positions exactly; then uploads a broken file and
-// expects the server's message on the page. Saves screenshots for people to look at.
+// support moved, and that undo restores the positions exactly; that the page's own normals after
+// the drag equal three.js's full recomputation, and that a stroke downloads no mesh again. On the
+// bundled bunny it also checks the editor's rules a new user meets (the manipulator only with the
+// Orbit tool and for a handle the server holds, a handle painted without support, k after a move,
+// the scale clamp, progress and busy buttons, export names, keys after a click, the brush keys,
+// the stats in view), the URL's display options and a broken upload's message.
 //
 //   node web/tests/e2e.mjs --cli build/bin/remora --web-root build/web --mesh data/bunny.ply \
 //        --screenshots build/
+//   node web/tests/e2e.mjs --cli build/bin/remora --web-root build/web --large 520000 --out build/
+//        (a bumpy torus of about that many triangles, written to build/, the core checks only)
 // Exit code 0: passed, 1: failed, 77: skipped (chromium or playwright-core missing).
-import { spawn } from 'node:child_process';
-import { existsSync } from 'node:fs';
 import { join } from 'node:path';
+import { args, check, chromiumOrSkip, client, drag, ready, recordRequests, results, startServer, stroke,
+         writeBumpyTorus } from './harness.mjs';
+import { bugChecks, displayOptions, brokenUpload } from './e2e_rules.mjs';
 
-const args = Object.fromEntries(process.argv.slice(2).reduce((pairs, a, i, all) =>
-  (a.startsWith('--') ? [...pairs, [a.slice(2), all[i + 1]]] : pairs), []));
-const chromiumPath = process.env.CHROMIUM ?? '/usr/bin/chromium';
-let chromium;
-try {
-  ({ chromium } = await import('playwright-core'));
-} catch (e) {
-  console.log('SKIP: playwright-core is not installed (scripts/build_web.sh installs it)');
-  process.exit(77);
-}
-if (!existsSync(chromiumPath)) {
-  console.log(`SKIP: no chromium at ${chromiumPath} (scripts/bootstrap.sh --web installs it)`);
-  process.exit(77);
-}
-
-let failures = 0;
-function check(ok, what) {
-  console.log(`${ok ? 'ok  ' : 'FAIL'} ${what}`);
-  if (!ok) failures += 1;
+const large = args.large ? Number(args.large) : 0;
+// Where to paint: the bunny's left ear, or the top of the torus (seen from +z).
+const site = large
+  ? { support: [1, 0, 0.4], supportRadius: 0.3, handle: [1, 0, 0.4], handleRadius: 0.06 }
+  : { support: [-0.03, 0.15, 0.0], supportRadius: 0.045, handle: [-0.035, 0.175, 0.0], handleRadius: 0.012 };
+let mesh = args.mesh;
+if (large) {
+  const nv = 320, nu = Math.ceil(large / (2 * nv));
+  mesh = join(args.out ?? '.', `torus_${2 * nu * nv}.ply`);
+  const t0 = Date.now();
+  writeBumpyTorus(mesh, nu, nv);
+  console.log(`wrote ${mesh} (${2 * nu * nv} triangles) in ${Date.now() - t0} ms`);
 }
 
-// The server, on a free port.
-const server = spawn(args.cli, ['serve', args.mesh, '--port', '0', '--web-root', args['web-root'], '--threads', '2'],
-                     { stdio: ['ignore', 'pipe', 'inherit'] });
-const url = await new Promise((resolve, reject) => {
-  let out = '';
-  server.stdout.on('data', (d) => { out += d; const m = out.match(/http:\/\/[^\s]+/); if (m) resolve(m[0]); });
-  server.on('exit', (code) => reject(new Error(`remora serve exited with ${code}`)));
-  setTimeout(() => reject(new Error('remora serve printed no URL in 30 s')), 30000);
-});
-const api = async (path, options) => {
-  const r = await fetch(url + 'api/' + path, options);
-  if (!r.ok) throw new Error(`${path}: ${r.status} ${await r.text()}`);
-  return r;
-};
-const floats = async (path) => new Float32Array(await (await api(path)).arrayBuffer());
+const browser = await chromiumOrSkip();
+const { server, url } = await startServer(args.cli, mesh, args['web-root'], ['--threads', '2']);
+const { api, floats, json } = client(url);
+const shot = async (page, name) => { if (args.screenshots) await page.screenshot({ path: join(args.screenshots, name) }); };
 
-const browser = await chromium.launch({ executablePath: chromiumPath, headless: true,
-  args: ['--use-gl=swiftshader', '--enable-unsafe-swiftshader', '--ignore-gpu-blocklist', '--no-sandbox'] });
-try {
-  const page = await browser.newPage({ viewport: { width: 1200, height: 800 } });
-  page.on('pageerror', (e) => { console.log('page error:', e.message); failures += 1; });
-  await page.goto(url);
-  await page.waitForFunction(() => window.remora?.ready(), null, { timeout: 120000 });
-  const before = await floats('mesh/positions');
-
-  // Paint: the support around the left ear, then the handle at its tip, with the mouse.
-  const ear = await page.evaluate(() => window.remora.nearest(-0.03, 0.15, 0.0));
-  const tip = await page.evaluate(() => window.remora.nearest(-0.035, 0.175, 0.0));
-  const stroke = async (vertex) => {
-    const p = await page.evaluate((v) => window.remora.project(v), vertex);
-    await page.mouse.move(p.x, p.y);
-    await page.mouse.down();
-    for (let i = 1; i <= 5; ++i) await page.mouse.move(p.x + i, p.y + i);
-    await page.mouse.up();
-  };
+/// Paints the support and then the handle at `site`, with the mouse; returns the requests made
+/// after the handle stroke's mouse-up, until the page is ready again.
+async function paintRegion(page, log) {
+  const near = (p) => page.evaluate((q) => window.remora.nearest(...q), p);
   await page.click('button[data-tool="support"]');
-  await page.evaluate(() => window.remora.setRadius(0.045));
-  await stroke(ear);
+  await page.evaluate((r) => window.remora.setRadius(r), site.supportRadius);
+  site.supportVertex = await near(site.support); // it rides along with later moves
+  await stroke(page, site.supportVertex);
   await page.click('button[data-tool="handle"]');
-  await page.evaluate(() => window.remora.setRadius(0.012));
-  await stroke(tip);
+  await page.evaluate((r) => window.remora.setRadius(r), site.handleRadius);
+  const handleVertex = await near(site.handle);
+  const p = await page.evaluate((v) => window.remora.project(v), handleVertex);
+  await page.mouse.move(p.x, p.y);
+  await page.mouse.down();
+  for (let i = 1; i <= 5; ++i) await page.mouse.move(p.x + i, p.y + i);
+  const from = log.length;
+  await page.mouse.up();
   await page.waitForFunction(async () => {
     const s = await (await fetch('api/status')).json();
     return s.state === 'ready' && s.region;
-  }, null, { timeout: 60000 });
-  await page.waitForFunction(() => window.remora.ready(), null, { timeout: 60000 });
-  const region = await (await api('region')).json();
-  check(region && region.support.length > 1000 && region.handles.length === 1 && region.handles[0].length > 20,
-        `painted a support (${region?.support.length} vertices) and a handle (${region?.handles[0]?.length})`);
+  }, null, { timeout: 120000 });
+  await ready(page);
+  return log.slice(from).map((r) => r.what);
+}
 
-  // Drag the manipulator's y arrow upwards.
+/// Drags the manipulator's y arrow upwards; returns the pivot's displacement.
+async function dragArrow(page) {
   await page.click('button[data-mode="translate"]');
   const pivot0 = await page.evaluate(() => window.remora.pivot());
-  const centre = await page.evaluate((c) => window.remora.projectPoint(c[0], c[1], c[2]), pivot0);
-  await page.mouse.move(centre.x, centre.y - 75);
-  await page.mouse.down();
-  for (let i = 1; i <= 10; ++i) await page.mouse.move(centre.x, centre.y - 75 - 8 * i);
-  await page.mouse.up();
-  await page.waitForFunction(() => window.remora.ready(), null, { timeout: 60000 });
+  const centre = await page.evaluate((c) => window.remora.projectPoint(...c), pivot0);
+  await drag(page, centre.x, centre.y - 75, 0, -8);
+  await ready(page);
   await page.waitForTimeout(300);
   const pivot1 = await page.evaluate(() => window.remora.pivot());
-  const dragged = pivot1.map((x, i) => x - pivot0[i]);
-  const status = await (await api('status')).json();
+  return pivot1.map((x, i) => x - pivot0[i]);
+}
+
+/// The core: paint, drag, the handle moved by the drag and nothing outside the support, the
+/// page's normals, no mesh download after a stroke, undo exact.
+async function core(page, log) {
+  const before = await floats('mesh/positions');
+  const afterStroke = await paintRegion(page, log);
+  const region = await json('region');
+  check(region && region.support.length > 1000 && region.handles.length === 1 && region.handles[0].length > 20,
+        `painted a support (${region?.support.length} vertices) and a handle (${region?.handles[0]?.length})`);
+  const downloads = afterStroke.filter((w) => /GET mesh\/(indices|positions)/.test(w));
+  check(downloads.length === 0, `a stroke's mouse-up downloads no mesh/indices or mesh/positions (${downloads.join(', ') || 'none'}; ` +
+        `requests: ${[...new Set(afterStroke)].join(', ')})`);
+  check(await page.evaluate(() => document.querySelector('#tools button.active')?.dataset.tool) === 'orbit' &&
+        (await page.evaluate(() => window.remora.shown())).manipulator,
+        'a ready region switches to the Orbit tool and shows the manipulator');
+
+  const dragged = await dragArrow(page);
+  const status = await json('status');
   const t = status.transforms[0];
   const translation = [t[3], t[7], t[11]];
-  check(Math.hypot(...dragged) > 0.005, `the drag moved the manipulator by ${Math.hypot(...dragged).toFixed(4)}`);
-  check(Math.hypot(...translation.map((x, i) => x - dragged[i])) < 1e-6,
-        'the server holds the dragged translation');
+  check(Math.hypot(...dragged) > 0.005 * (large ? 10 : 1), `the drag moved the manipulator by ${Math.hypot(...dragged).toFixed(4)}`);
+  check(Math.hypot(...translation.map((x, i) => x - dragged[i])) < 1e-6, 'the server holds the dragged translation');
   const after = await floats('mesh/positions');
   // The handle's vertices moved by the dragged amount (median over the handle: the rim's details
   // rotate slightly with the bend).
@@ -113,58 +108,51 @@ try {
     if (!inSupport.has(v))
       for (let c = 0; c < 3; ++c) if (after[3 * v + c] !== before[3 * v + c]) { outsideMoved += 1; break; }
   check(outsideMoved === 0, `no vertex outside the support moved (${outsideMoved} did)`);
-  if (args.screenshots) await page.screenshot({ path: join(args.screenshots, 'editor-dragged.png') });
-  // The hidden base and its wireframe coloured by vertex area.
-  await page.check('#show-wire');
-  await page.waitForFunction(() => window.remora.ready(), null, { timeout: 60000 });
-  if (args.screenshots) await page.screenshot({ path: join(args.screenshots, 'editor-base-wireframe.png') });
-  await page.uncheck('#show-wire');
+  const normalError = await page.evaluate(() => window.remora.normalError?.() ?? Infinity);
+  check(normalError < 1e-5, `after the drag the page's normals equal a full computeVertexNormals() (off by ${normalError.toExponential(2)})`);
+  await shot(page, large ? 'editor-large-dragged.png' : 'editor-dragged.png');
+  if (!large) {
+    // The hidden base and its wireframe coloured by vertex area.
+    await page.check('#show-wire');
+    await ready(page);
+    await shot(page, 'editor-base-wireframe.png');
+    await page.uncheck('#show-wire');
+  }
 
-  // Undo (the button) restores the positions before the drag exactly.
+  // Undo (the button) restores the positions before the drag exactly; redo brings the drag back.
   await page.click('#undo');
-  await page.waitForFunction(() => window.remora.ready(), null, { timeout: 60000 });
+  await ready(page);
   await page.waitForTimeout(300);
   const undone = await floats('mesh/positions');
   let differ = 0;
   for (let i = 0; i < before.length; ++i) if (undone[i] !== before[i]) differ += 1;
   check(differ === 0, `undo restored every position exactly (${differ} coordinates differ)`);
+  await page.click('#redo');
+  await ready(page);
+  return { region, translation };
+}
 
-  // The mesh's own triangles as a wireframe (the "its triangles" checkbox).
-  await page.check('#show-edges');
-  check((await page.evaluate(() => window.remora.shown())).edges, 'the "its triangles" checkbox shows the wireframe');
-  await page.uncheck('#show-edges');
-  check(!(await page.evaluate(() => window.remora.shown())).edges, 'and unchecking it hides the wireframe');
-
-  // The display options in the URL (scripts/render_pictures.mjs): no panel or manipulator, the
-  // camera given, the checkboxes set.
-  const bare = await browser.newPage({ viewport: { width: 400, height: 300 } });
-  bare.on('pageerror', (e) => { console.log('page error:', e.message); failures += 1; });
-  await bare.goto(url + '?ui=0&show-mesh=0&show-edges=1&show-wire=1&camera=0.1,0.2,0.3,0,0.1,0');
-  await bare.waitForFunction(() => window.remora?.ready(), null, { timeout: 120000 });
-  const shown = await bare.evaluate(() => window.remora.shown());
-  const cameraAt = await bare.evaluate(() => window.remora.camera());
-  const canvasBox = await bare.locator('canvas').boundingBox();
-  check(await bare.isHidden('#panel') && canvasBox.x === 0 && canvasBox.width === 400,
-        'ui=0 hides the panel and the view fills the window');
-  check(!shown.mesh && shown.edges && shown.wire && !shown.base && !shown.manipulator,
-        `show-*= set the checkboxes, and ui=0 hides the manipulator (${JSON.stringify(shown)})`);
-  check(Math.hypot(...cameraAt.map((x, i) => x - [0.1, 0.2, 0.3][i])) < 1e-9, `camera= places the camera (${cameraAt})`);
-  await bare.close();
-
-  // A broken upload: the server's message appears on the page.
-  await page.setInputFiles('#file', { name: 'broken.ply', mimeType: 'application/octet-stream',
-    buffer: Buffer.from('ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nend_header\n1\n2\n') });
-  await page.waitForSelector('#message:not([hidden])', { timeout: 30000 });
-  await page.waitForFunction(() => /broken\.ply/.test(document.getElementById('message').textContent), null, { timeout: 30000 });
-  const text = await page.textContent('#message');
-  check(/broken\.ply/.test(text), `a broken upload shows the server's message: "${text.trim()}"`);
-  if (args.screenshots) await page.screenshot({ path: join(args.screenshots, 'editor-broken-upload.png') });
+let page;
+try {
+  page = await browser.newPage({ viewport: { width: 1200, height: 800 } });
+  page.on('pageerror', (e) => { console.log('page error:', e.message); results.failures += 1; });
+  const log = recordRequests(page);
+  await page.goto(url);
+  await ready(page, 300000);
+  if (!large) await bugChecks.beforeRegion(page, log, { api, floats, json }, site);
+  const edit = await core(page, log);
+  if (!large) {
+    await bugChecks.afterRegion(page, log, { api, floats, json }, edit, site);
+    await displayOptions(browser, url);
+    await brokenUpload(page, args.screenshots);
+  }
 } catch (e) {
   console.log('FAIL', e.message);
-  failures += 1;
+  results.failures += 1;
+  if (page) await shot(page, 'editor-failure.png').catch(() => {});
 } finally {
   await browser.close();
   server.kill('SIGTERM');
 }
-console.log(failures ? `${failures} check(s) failed` : 'all checks passed');
-process.exit(failures ? 1 : 0);
+console.log(results.failures ? `${results.failures} check(s) failed` : 'all checks passed');
+process.exit(results.failures ? 1 : 0);

@@ -1,0 +1,230 @@
+// The editor's rules a new user meets, checked with the mouse and the keyboard on the bunny
+// (web/tests/e2e.mjs runs them before and after its core edit), the URL's display options, and a
+// broken upload's message.
+import { join } from 'node:path';
+import { check, drag, ready, stroke } from './harness.mjs';
+
+const remora = (page, what, ...a) => page.evaluate(([w, b]) => {
+  const f = window.remora[w];
+  return typeof f === 'function' ? f(...b) : undefined;
+}, [what, a]);
+const since = (log, from, pattern) => log.slice(from).filter((r) => pattern.test(r.what));
+const activeTool = (page) => page.evaluate(() => document.querySelector('#tools button.active')?.dataset.tool);
+const brushRadius = (page) => page.evaluate(() => Number(document.getElementById('radius').value));
+const messageBox = (page) => page.evaluate(() => {
+  const box = document.getElementById('message');
+  return { text: box.textContent, kind: box.className, hidden: box.hidden };
+});
+
+/// A handle painted without support is not sent, and its paint and message stay.
+async function handleWithoutSupport(page, log, site) {
+  const from = log.length;
+  await page.click('button[data-tool="handle"]');
+  await remora(page, 'setRadius', site.handleRadius);
+  await stroke(page, await remora(page, 'nearest', ...site.handle));
+  await page.waitForTimeout(500);
+  await ready(page);
+  const painted = (await remora(page, 'labels')).filter((l) => l >= 0).length;
+  const box = await messageBox(page);
+  check(since(log, from, /POST region/).length === 0 && painted > 0 && !box.hidden && /support/i.test(box.text),
+        `one Handle stroke on a fresh load: no region sent (${since(log, from, /POST region/).length} sent), ` +
+        `the paint stays (${painted} vertices), and the message asks for the support ("${box.text}")`);
+  await page.click('#clear');
+}
+
+/// Keys act after a click on a checkbox, the slider or the k select; [ ] and Ctrl+wheel scale the
+/// brush; the brush cursor shows its radius on hover.
+async function keysAndBrush(page, site) {
+  await page.click('#show-edges');
+  await page.click('#show-edges');
+  await page.keyboard.press('s');
+  const afterCheckbox = await activeTool(page);
+  await page.focus('#k');
+  await page.keyboard.press('h');
+  const afterSelect = await activeTool(page);
+  await page.focus('#radius');
+  await page.keyboard.press('s');
+  const afterSlider = await activeTool(page);
+  check(afterCheckbox === 'support' && afterSelect === 'handle' && afterSlider === 'support',
+        `S and H work after a click on a checkbox, the k select and the slider (${afterCheckbox}, ${afterSelect}, ${afterSlider})`);
+  await remora(page, 'setRadius', site.supportRadius);
+  const r0 = await brushRadius(page);
+  await page.keyboard.press(']');
+  const r1 = await brushRadius(page);
+  await page.keyboard.press('[');
+  await page.keyboard.press('[');
+  const r2 = await brushRadius(page);
+  const p = await remora(page, 'project', await remora(page, 'nearest', ...site.support));
+  await page.mouse.move(p.x, p.y);
+  await page.keyboard.down('Control');
+  await page.mouse.wheel(0, 100);
+  await page.keyboard.up('Control');
+  const r3 = await brushRadius(page);
+  const close = (a, b) => Math.abs(a - b) <= 1e-9 * Math.abs(b);
+  check(close(r1, 1.25 * r0) && close(r2, 0.8 * r1 * 0.8) && close(r3, 0.8 * r2),
+        `] grows the brush by 1.25, [ shrinks it by 0.8, Ctrl+wheel too (${r0}, ${r1}, ${r2}, ${r3})`);
+  await page.mouse.move(p.x + 1, p.y);
+  await page.waitForFunction(() => window.remora.shown?.().cursor, null, { timeout: 10000 }).catch(() => {});
+  const shown = await remora(page, 'shown');
+  check(shown?.cursor && close(shown.cursorRadius, r3),
+        `hovering with a paint tool shows the brush ring of the brush's radius (${shown?.cursorRadius} against ${r3})`);
+  await page.keyboard.press('o');
+}
+
+/// Changing k after a move keeps the move: the same transforms, the handle where it was, and
+/// k = 2 again gives the k = 2 shape.
+async function kAfterMove(page, c, edit) {
+  const s0 = await c.json('status');
+  const p2 = await c.floats('mesh/positions');
+  const pivot0 = await remora(page, 'pivot');
+  await page.selectOption('#k', '1');
+  await ready(page);
+  const s1 = await c.json('status');
+  const p1 = await c.floats('mesh/positions');
+  const same = JSON.stringify(s1.transforms) === JSON.stringify(s0.transforms);
+  const handle = edit.region.handles[0];
+  // The handle's base moves rigidly whatever k; its rim's details follow the base's normals, so
+  // the median over the handle is the measure.
+  const offs = handle.map((v) => Math.hypot(...[0, 1, 2].map((k) => p1[3 * v + k] - p2[3 * v + k]))).sort((a, b) => a - b);
+  const handleOff = offs[offs.length >> 1];
+  let supportChange = 0;
+  for (const v of edit.region.support) for (let k = 0; k < 3; ++k) supportChange = Math.max(supportChange, Math.abs(p1[3 * v + k] - p2[3 * v + k]));
+  const pivot1 = await remora(page, 'pivot');
+  check(same && s1.region?.k === 1, `k = 1 after a move keeps the transforms (${JSON.stringify(s1.transforms?.[0]?.slice(9))})`);
+  check(handleOff < 1e-6 && supportChange > 1e-5 && Math.hypot(...pivot1.map((x, i) => x - pivot0[i])) < 1e-9,
+        `the handle stays moved (median off by ${handleOff.toExponential(2)}), the support bends otherwise ` +
+        `(${supportChange.toExponential(2)}), the manipulator stays`);
+  const pageOff = await page.evaluate(async () => {
+    const server = new Float32Array(await (await fetch('api/mesh/positions')).arrayBuffer());
+    const held = window.remora.positionsHeld?.() ?? [];
+    let worst = held.length === server.length ? 0 : Infinity;
+    for (let i = 0; i < held.length && worst < Infinity; ++i) worst = Math.max(worst, Math.abs(held[i] - server[i]));
+    return worst;
+  });
+  check(pageOff === 0, `the page shows the new k's positions (off by ${pageOff})`);
+  for (const k of ['3', '2']) { await page.selectOption('#k', k); await ready(page); }
+  const back = await c.floats('mesh/positions');
+  let off = 0;
+  for (let i = 0; i < back.length; ++i) off = Math.max(off, Math.abs(back[i] - p2[i]));
+  check(off < 1e-5, `k = 3 then 2 gives back the k = 2 shape without undo (off by ${off.toExponential(2)})`);
+}
+
+/// While a job runs (a stroke after a move: the shape is baked into a new base) the progress shows
+/// "phase — NN %" and undo, redo and export are disabled.
+async function busyButtons(page, site) {
+  await page.keyboard.press('s');
+  await remora(page, 'setRadius', 1.4 * site.supportRadius);
+  await stroke(page, site.supportVertex);
+  await page.waitForFunction(() => !document.getElementById('progress').hidden || window.remora.ready(),
+                             null, { timeout: 60000, polling: 20 });
+  const during = await page.evaluate(() => ({
+    progress: document.getElementById('progress').hidden ? null : document.getElementById('progress-text').textContent,
+    disabled: ['#undo', '#redo', '#export button, #panel a.button'].map((q) => [...document.querySelectorAll(q)].every((b) => b.disabled)),
+  }));
+  check(during.progress && /\d+ %/.test(during.progress) && during.disabled.every(Boolean),
+        `while a bake runs: "${during.progress}", undo, redo and export disabled (${during.disabled})`);
+  await ready(page, 180000);
+  await page.keyboard.press('o');
+}
+
+/// Scaling through the pivot never sends a map that flips orientation (det > 0).
+async function scaleClamp(page, log) {
+  await page.keyboard.press('r');
+  const centre = await remora(page, 'projectPoint', ...(await remora(page, 'pivot')));
+  const from = log.length;
+  await drag(page, centre.x, centre.y - 75, 0, 15, 12);
+  await ready(page);
+  const sent = since(log, from, /POST transform/).map((r) => r.body.matrix);
+  const det = (m) => m[0] * (m[5] * m[10] - m[6] * m[9]) - m[1] * (m[4] * m[10] - m[6] * m[8]) + m[2] * (m[4] * m[9] - m[5] * m[8]);
+  const smallest = Math.min(...sent.map(det));
+  check(sent.length > 0 && smallest > 0, `scaling through the pivot: ${sent.length} maps sent, smallest det ${smallest.toFixed(4)}`);
+  await page.keyboard.press('w');
+}
+
+/// Export downloads a file named after the mesh, and a refused export shows the server's message.
+async function exportName(page) {
+  const button = '#panel :is(a, button):text-is("PLY")';
+  const [download] = await Promise.all([page.waitForEvent('download', { timeout: 30000 }), page.click(button)]);
+  check(download.suggestedFilename() === 'bunny_edited.ply', `export is named ${download.suggestedFilename()}`);
+  const refusal = 'the session is busy (a refusal made by the test)';
+  await page.route('**/api/export*', (route) => route.fulfill({
+    status: 409, contentType: 'application/json', body: JSON.stringify({ error: refusal }) }));
+  await page.click(button);
+  await page.waitForFunction((t) => document.getElementById('message').textContent === t, refusal, { timeout: 10000 })
+    .catch(() => {});
+  const box = await messageBox(page);
+  check(!box.hidden && box.text === refusal, `a refused export shows the server's message ("${box.hidden ? '' : box.text}")`);
+  await page.unroute('**/api/export*');
+}
+
+/// With a paint tool the manipulator is hidden and a stroke from its arrow paints or orbits, it
+/// never moves the handle; a new handle detaches it.
+async function manipulatorRules(page, log) {
+  const pivot0 = await remora(page, 'pivot');
+  const centre = await remora(page, 'projectPoint', ...pivot0);
+  await page.keyboard.press('s');
+  const hidden = !(await remora(page, 'shown')).manipulator;
+  let from = log.length;
+  await drag(page, centre.x, centre.y - 75, 0, -8);
+  await ready(page);
+  const moved = since(log, from, /POST transform/).length;
+  check(hidden && moved === 0, `with the Support tool the manipulator is hidden (${hidden}) and a stroke from its arrow sends no move (${moved})`);
+  await page.keyboard.press('o');
+  await page.click('#new-handle');
+  await page.keyboard.press('o');
+  const shown = (await remora(page, 'shown')).manipulator;
+  const centre1 = await remora(page, 'projectPoint', ...(await remora(page, 'pivot')));
+  from = log.length;
+  await drag(page, centre1.x, centre1.y - 75, 0, -8);
+  await ready(page);
+  const box = await messageBox(page);
+  const sent = since(log, from, /POST transform/).length;
+  check(!shown && sent === 0 && !/does not exist/.test(box.text),
+        `after New handle the manipulator is hidden (${shown}) and its old place sends no move (${sent}; "${box.hidden ? '' : box.text}")`);
+}
+
+export const bugChecks = {
+  async beforeRegion(page, log, c, site) {
+    await handleWithoutSupport(page, log, site);
+    await keysAndBrush(page, site);
+  },
+  async afterRegion(page, log, c, edit, site) {
+    const box = await page.locator('#stats').boundingBox();
+    const text = await page.textContent('#stats');
+    check(box && box.y >= 0 && box.y + box.height <= 800 && /set_region/.test(text),
+          `at 1200x800 the stats, set_region line included, are in view (${box?.y.toFixed(0)}..${(box?.y + box?.height).toFixed(0)})`);
+    await kAfterMove(page, c, edit);
+    await busyButtons(page, site);
+    await scaleClamp(page, log);
+    await exportName(page);
+    await manipulatorRules(page, log);
+  },
+};
+
+/// The display options in the URL (scripts/render_pictures.mjs): no panel or manipulator, the
+/// camera given, the checkboxes set.
+export async function displayOptions(browser, url) {
+  const bare = await browser.newPage({ viewport: { width: 400, height: 300 } });
+  bare.on('pageerror', (e) => { check(false, `page error: ${e.message}`); });
+  await bare.goto(url + '?ui=0&show-mesh=0&show-edges=1&show-wire=1&camera=0.1,0.2,0.3,0,0.1,0');
+  await ready(bare);
+  const shown = await bare.evaluate(() => window.remora.shown());
+  const cameraAt = await bare.evaluate(() => window.remora.camera());
+  const canvasBox = await bare.locator('canvas').boundingBox();
+  check(await bare.isHidden('#panel') && canvasBox.x === 0 && canvasBox.width === 400,
+        'ui=0 hides the panel and the view fills the window');
+  check(!shown.mesh && shown.edges && shown.wire && !shown.base && !shown.manipulator,
+        `show-*= set the checkboxes, and ui=0 hides the manipulator (${JSON.stringify(shown)})`);
+  check(Math.hypot(...cameraAt.map((x, i) => x - [0.1, 0.2, 0.3][i])) < 1e-9, `camera= places the camera (${cameraAt})`);
+  await bare.close();
+}
+
+/// A broken upload: the server's message appears on the page.
+export async function brokenUpload(page, screenshots) {
+  await page.setInputFiles('#file', { name: 'broken.ply', mimeType: 'application/octet-stream',
+    buffer: Buffer.from('ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nend_header\n1\n2\n') });
+  await page.waitForFunction(() => /broken\.ply/.test(document.getElementById('message').textContent), null, { timeout: 30000 });
+  const text = await page.textContent('#message');
+  check(/broken\.ply/.test(text), `a broken upload shows the server's message: "${text.trim()}"`);
+  if (screenshots) await page.screenshot({ path: join(screenshots, 'editor-broken-upload.png') });
+}
