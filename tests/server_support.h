@@ -45,7 +45,7 @@ inline HttpResponse call(Session& s, const std::string& method, const std::strin
 template <class T>
 std::vector<T> as(const HttpResponse& r) {
   std::vector<T> out(r.body.size() / sizeof(T));
-  std::memcpy(out.data(), r.body.data(), out.size() * sizeof(T));
+  if (!out.empty()) std::memcpy(out.data(), r.body.data(), out.size() * sizeof(T));
   return out;
 }
 
