@@ -110,20 +110,21 @@ const picks = new Coalescer((q) => pick(q.ray, q.radius, q.brush), onPick);
 function onPick(hit, q) {
   if (q.paint && !painting && q.stroke !== strokeCount) return; // a stroke's late answer after the next began
   lastHover = hit;
-  if (hit.face < 0 || !hit.point || state.tool === 'orbit') { view.hideCursor(); return; }
-  view.showCursor(hit.point, faceNormal(state.positions, state.indices, hit.face), panels.radius());
-  if (q.paint) {
-    paint(hit.ids);
+  const onMesh = hit.face >= 0 && !!hit.point;
+  if (onMesh && state.tool !== 'orbit') view.showCursor(hit.point, faceNormal(state.positions, state.indices, hit.face), panels.radius());
+  else view.hideCursor();
+  if (q.paint && onMesh) {
+    paint(hit.ids, q.tool, q.label);
     state.marks.paintMove.push(performance.now() - q.t0);
   }
 }
 
-function paint(ids) {
-  const label = state.tool === 'support' ? FREE : state.tool === 'handle' ? state.selected : FIXED;
+/// Paints ids with `label` as `tool` did when the stroke asked for them.
+function paint(ids, tool, label) {
   const touched = [];
   for (const v of ids) {
     const old = state.labels[v];
-    if (state.tool === 'support' && old >= 0) continue; // painting the support keeps handles
+    if (tool === 'support' && old >= 0) continue; // painting the support keeps handles
     if (old !== label) { state.labels[v] = label; touched.push(v); }
   }
   if (touched.length) { state.dirtyRegion = true; view.colour(state.labels, touched); }
@@ -131,8 +132,9 @@ function paint(ids) {
 
 let strokeCount = 0;
 function submitPick(event, paintIt) {
+  const tool = state.tool, label = tool === 'support' ? FREE : tool === 'handle' ? state.selected : FIXED;
   picks.submit({ ray: view.rayAt(event), radius: paintIt ? panels.radius() : 0, brush: panels.brush(),
-                 paint: paintIt, stroke: strokeCount, t0: performance.now() });
+                 paint: paintIt, tool, label, stroke: strokeCount, t0: performance.now() });
 }
 
 // In the capture phase, before the orbit controls: a stroke that starts on the mesh paints, one

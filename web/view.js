@@ -34,7 +34,9 @@ export function createControls(up) {
   if (up) camera.up.fromArray(up).normalize();
   orbit = new OrbitControls(camera, renderer.domElement);
   orbit.enableDamping = false;
+  orbit.addEventListener('change', redraw);
   gizmo = new TransformControls(camera, renderer.domElement);
+  gizmo.addEventListener('change', redraw);
   scene.add(pivot);
   gizmoHelper = gizmo.getHelper ? gizmo.getHelper() : gizmo;
   scene.add(gizmoHelper);
@@ -46,6 +48,7 @@ export function showGizmo(on) {
   if (on && gizmo.object !== pivot) gizmo.attach(pivot);
   gizmo.enabled = on;
   gizmoHelper.visible = on;
+  redraw();
 }
 export const gizmoPlaced = () => gizmo.object === pivot;
 /// Forgets the manipulator's place (a new region or handle places it again).
@@ -60,11 +63,17 @@ const edgeMaterial = new THREE.MeshBasicMaterial({ color: 0x30343c, wireframe: t
 export const shown = { mesh: null, edges: null, baseLines: null, baseSurface: null };
 let plan = null; // normalPlan() of the current movable vertices
 
+// Frames are drawn on demand (redraw(), or an attribute touched): an idle page costs nothing,
+// and software WebGL does not hold back input events with frames nobody needs.
+let dirty = true;
+export function redraw() { dirty = true; }
+
 function resize() {
   const w = container.clientWidth, h = container.clientHeight;
   renderer.setSize(w, h);
   camera.aspect = w / Math.max(h, 1);
   camera.updateProjectionMatrix();
+  redraw();
 }
 new ResizeObserver(resize).observe(container); // the window, and the panel shown or hidden (ui=0)
 resize();
@@ -77,6 +86,8 @@ function touch(attribute, lo = null, hi = null) {
   touched.set(attribute, old ? { lo: Math.min(old.lo, lo), hi: Math.max(old.hi, hi) } : { lo, hi });
 }
 renderer.setAnimationLoop(() => {
+  if (!dirty && touched.size === 0) return;
+  dirty = false;
   for (const [attribute, range] of touched) {
     attribute.clearUpdateRanges();
     if (range) attribute.addUpdateRange(attribute.itemSize * range.lo, attribute.itemSize * (range.hi - range.lo + 1));
@@ -105,6 +116,7 @@ export function setMesh(positions, indices) {
   scene.add(shown.mesh);
   scene.add(shown.edges);
   plan = null;
+  redraw();
 }
 
 /// Every position changed (undo, redo, a new k): positions.set() was called on the held array.
@@ -175,6 +187,7 @@ export function fitCamera(cameraParam) {
   }
   camera.updateProjectionMatrix();
   orbit.update();
+  redraw();
   return sphere.radius;
 }
 
@@ -182,6 +195,7 @@ export function showMesh(mesh, edges) {
   if (!shown.mesh) return;
   shown.mesh.visible = mesh;
   shown.edges.visible = edges;
+  redraw();
 }
 
 /// The world-space ray under a pointer event: { origin: [x, y, z], direction: [x, y, z] }.
@@ -231,11 +245,13 @@ export function setBase(positions, indices, areas, areaRange) {
     polygonOffset: true, polygonOffsetFactor: 1, polygonOffsetUnits: 1 }));
   scene.add(shown.baseSurface);
   scene.add(shown.baseLines);
+  redraw();
 }
 export const hasBase = () => !!shown.baseLines;
 export function showBase(surface, wire) {
   if (shown.baseLines) shown.baseLines.visible = wire;
   if (shown.baseSurface) shown.baseSurface.visible = surface;
+  redraw();
 }
 
 // ---- the brush cursor: a ring of the brush's radius on the surface under the pointer ------------
@@ -255,8 +271,9 @@ export function showCursor(point, normal, radius) {
   if (n.lengthSq() > 0) cursor.quaternion.setFromUnitVectors(zAxis, n.normalize());
   cursor.scale.setScalar(Math.max(radius, 1e-9));
   cursor.visible = true;
+  redraw();
 }
-export function setCursorRadius(radius) { cursor.scale.setScalar(Math.max(radius, 1e-9)); }
-export function hideCursor() { cursor.visible = false; }
+export function setCursorRadius(radius) { cursor.scale.setScalar(Math.max(radius, 1e-9)); redraw(); }
+export function hideCursor() { if (cursor.visible) { cursor.visible = false; redraw(); } }
 export const cursorShown = () => cursor.visible;
 export const cursorRadius = () => (cursor.visible ? cursor.scale.x : 0);
