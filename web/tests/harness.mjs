@@ -28,8 +28,9 @@ export async function chromiumOrSkip() {
 }
 
 export const results = { failures: 0 };
+const t0 = Date.now();
 export function check(ok, what) {
-  console.log(`${ok ? 'ok  ' : 'FAIL'} ${what}`);
+  console.log(`${ok ? 'ok  ' : 'FAIL'} ${what} [${((Date.now() - t0) / 1000).toFixed(0)} s]`);
   if (!ok) results.failures += 1;
 }
 
