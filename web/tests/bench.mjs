@@ -1,0 +1,95 @@
+// The browser editor's latency, measured in the page (performance.now() marks, window.remora.marks)
+// while the real page is driven with the mouse in headless chromium (SwiftShader WebGL):
+//   ready_ms             server start to a paintable page;
+//   paint_move_ms        one pointer move while painting with a large brush, until its colours are set;
+//   mouseup_to_gizmo_ms  the handle stroke's mouse-up to the manipulator on the solved region;
+//   drag_cycle_ms        one manipulator move to its positions and normals applied, mesh hidden
+//                        (software WebGL's drawing not counted); drag_cycle_shown_ms, mesh shown;
+//   bake_ms              a new stroke after a move (the edited shape baked, a new region) until paintable;
+//   bytes_per_frame      the transform answer's size; support_vertices, the region's support.
+// All medians. The last line printed is one JSON object with these keys.
+//
+//   node web/tests/bench.mjs --cli build/bin/remora --web-root build/web [--mesh data/bunny.ply]
+//        [--support-radius R] [--moves N]
+// R is in the mesh's units (default: a fifth of its bounding radius); the support is painted at
+// the surface under the view's centre. Exit code 0: done, 1: failed, 77: chromium or
+// playwright-core missing.
+import { args, chromiumOrSkip, client, drag, ready, startServer } from './harness.mjs';
+
+const moves = Number(args.moves ?? 30);
+const median = (xs) => { const s = [...xs].sort((a, b) => a - b); return s.length ? s[s.length >> 1] : null; };
+const round = (x) => (x === null ? null : Math.round(x * 100) / 100);
+
+const browser = await chromiumOrSkip();
+const { server, url, started } = await startServer(args.cli, args.mesh ?? 'data/bunny.ply', args['web-root'], []);
+const { json } = client(url);
+let failed = false;
+try {
+  const page = await browser.newPage({ viewport: { width: 1200, height: 800 } });
+  page.on('pageerror', (e) => { console.log('page error:', e.message); failed = true; });
+  await page.goto(url);
+  await ready(page, 600000);
+  const marks = () => page.evaluate(() => window.remora.marks());
+  const paintableAt = await page.evaluate(() => performance.timeOrigin + window.remora.marks().paintable);
+  const box = await page.locator('canvas').boundingBox();
+  const centre = { x: box.x + box.width / 2, y: box.y + box.height / 2 };
+  const bound = await page.evaluate(() => Number(document.getElementById('radius').max));
+  const supportRadius = Number(args['support-radius'] ?? bound / 5);
+
+  // The support: a stroke of `moves` pointer moves with the large brush.
+  await page.keyboard.press('s');
+  await page.evaluate((r) => window.remora.setRadius(r), supportRadius);
+  const paintFrom = (await marks()).paintMove.length;
+  await drag(page, centre.x - moves, centre.y, 2, 0, moves);
+  await ready(page);
+  const paintMove = (await marks()).paintMove.slice(paintFrom);
+  // The handle inside it, smaller; its mouse-up sends the region.
+  await page.keyboard.press('h');
+  await page.evaluate((r) => window.remora.setRadius(r / 4), supportRadius);
+  await drag(page, centre.x, centre.y, 1, 0, 3);
+  await ready(page, 600000);
+  let m = await marks();
+  const mouseupToGizmo = m.regionReady[m.regionReady.length - 1] - m.strokeEnd;
+  const support = (await json('status')).region?.support ?? 0;
+
+  // Drags of the manipulator's arrow, the mesh shown, then hidden.
+  const dragCycle = async () => {
+    const from = (await marks()).drag.length;
+    const pivot = await page.evaluate(() => window.remora.pivot());
+    const c = await page.evaluate((p) => window.remora.projectPoint(...p), pivot);
+    await page.keyboard.press('w');
+    await drag(page, c.x, c.y - 75, 0, -1, moves);
+    await ready(page);
+    const mm = await marks();
+    return { ms: mm.drag.slice(from), bytes: mm.dragBytes.slice(from) };
+  };
+  const shown = await dragCycle();
+  await page.uncheck('#show-mesh');
+  const hidden = await dragCycle();
+  await page.check('#show-mesh');
+
+  // A new support stroke after the move: the edited shape is baked into a new base.
+  await page.keyboard.press('s');
+  await page.evaluate((r) => window.remora.setRadius(1.3 * r), supportRadius);
+  const regions = m.regionReady.length;
+  await drag(page, centre.x, centre.y, 1, 1, 3);
+  await ready(page, 600000);
+  m = await marks();
+  const bake = m.regionReady.length > regions ? m.regionReady[m.regionReady.length - 1] - m.strokeEnd : null;
+
+  const result = {
+    ready_ms: round(paintableAt - started), paint_move_ms: round(median(paintMove)),
+    mouseup_to_gizmo_ms: round(mouseupToGizmo), drag_cycle_ms: round(median(hidden.ms)),
+    drag_cycle_shown_ms: round(median(shown.ms)), bake_ms: round(bake),
+    bytes_per_frame: median([...shown.bytes, ...hidden.bytes]), support_vertices: support,
+    paint_moves: paintMove.length, drag_frames: hidden.ms.length + shown.ms.length,
+  };
+  console.log(JSON.stringify(result));
+} catch (e) {
+  console.log('bench failed:', e.message);
+  failed = true;
+} finally {
+  await browser.close();
+  server.kill('SIGTERM');
+}
+process.exit(failed ? 1 : 0);
