@@ -141,6 +141,35 @@ TEST(RayCaster, ARefittedTreeAgreesWithTheMovedMesh) {
   EXPECT_THROW(caster.refit(make_icosphere(1, 1.0)), InvalidArgument);
 }
 
+// A drag moves a region: refitting only around the moved vertices answers as a full refit does.
+TEST(RayCaster, APartialRefitAgreesWithAFullOne) {
+  Mesh mesh = two_shells();
+  RayCaster partial(mesh), full(mesh);
+  std::mt19937 rng(23);
+  std::uniform_real_distribution<double> u(-1.5, 1.5), in(-0.5, 0.5);
+  for (int step = 0; step < 3; ++step) {
+    std::vector<int> moved;
+    for (const VertexHandle v : mesh.vertices()) {
+      const Vec3 p = mesh.point(v);
+      if (p[0] < 0.2 * step - 0.1) continue; // a cap of the outer shell, another each step
+      mesh.set_point(v, p + Vec3(0.3, 0.1 * step, -0.2));
+      moved.push_back(v.idx());
+    }
+    partial.refit(mesh, moved);
+    full.refit(mesh);
+    for (int i = 0; i < 500; ++i) {
+      const Vec3 o(in(rng), in(rng), in(rng)), d(u(rng), u(rng), u(rng));
+      const RayHit a = partial.first_hit(o, d, 0.0, kInf), b = full.first_hit(o, d, 0.0, kInf);
+      ASSERT_EQ(a.face, b.face) << "step " << step << " ray " << i;
+      EXPECT_EQ(a.t, b.t);
+      if (a.face.is_valid()) {
+        EXPECT_NEAR(a.t, brute_force(mesh, o, d, 0.0, kInf), 1e-9);
+      }
+    }
+  }
+  EXPECT_THROW(partial.refit(mesh, {-1}), InvalidArgument);
+}
+
 TEST(RayCaster, FromAVertexSkipsItsOwnFacesAndMeetsTheFarSide) {
   const Mesh cube = make_cube(3, 2.0);
   const RayCaster caster(cube);

@@ -27,9 +27,14 @@ void Shape::set_positions(const Eigen::MatrixXd& positions) {
 }
 
 void Shape::set_positions(const std::vector<int>& ids, const Eigen::MatrixXd& positions) {
-  for (const int i : ids)
+  if (moved_flag_.size() != mesh_.n_vertices()) moved_flag_.assign(mesh_.n_vertices(), 0);
+  for (const int i : ids) {
     mesh_.set_point(VertexHandle(i), Vec3(positions(i, 0), positions(i, 1), positions(i, 2)));
-  stale_ = true;
+    if (!moved_flag_[static_cast<std::size_t>(i)]) {
+      moved_flag_[static_cast<std::size_t>(i)] = 1;
+      moved_.push_back(i);
+    }
+  }
 }
 
 Pick Shape::pick(const Vec3& origin, const Vec3& direction, double radius, Brush brush) {
@@ -39,7 +44,11 @@ Pick Shape::pick(const Vec3& origin, const Vec3& direction, double radius, Brush
     caster_.emplace(mesh_);
   else if (stale_)
     caster_->refit(mesh_);
+  else if (!moved_.empty())
+    caster_->refit(mesh_, moved_); // a drag moved only its region
   stale_ = false;
+  for (const int i : moved_) moved_flag_[static_cast<std::size_t>(i)] = 0;
+  moved_.clear();
   const RayHit hit =
       caster_->first_hit(origin, direction, 0.0, std::numeric_limits<double>::infinity());
   Pick out;

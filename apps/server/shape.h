@@ -49,7 +49,9 @@ public:
 private:
   Mesh mesh_;
   std::optional<RayCaster> caster_;
-  bool stale_ = true;
+  bool stale_ = true;      // every vertex may have moved since the caster's last refit
+  std::vector<int> moved_; // else these did (each once)
+  std::vector<char> moved_flag_;
   FastMarching marching_;
 };
 

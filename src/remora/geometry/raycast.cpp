@@ -4,6 +4,7 @@
 #include <cassert>
 #include <cmath>
 #include <cstddef>
+#include <functional>
 
 #include <fmt/format.h>
 
@@ -137,45 +138,107 @@ RayCaster::RayCaster(const Mesh& mesh) {
   faces_ = std::move(sorted);
 }
 
+namespace {
+
+/// The point of vertex `v` of `mesh`; throws InvalidArgument when it is not finite.
+const Vec3& finite_point(const Mesh& mesh, int v) {
+  const Vec3& p = mesh.point(VertexHandle(v));
+  if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
+    throw InvalidArgument(
+        fmt::format("ray caster: vertex {} is not finite; repair the mesh first", v));
+  return p;
+}
+
+} // namespace
+
+void RayCaster::refit_node(std::size_t i) {
+  Node& n = nodes_[i];
+  if (n.count == 0) {
+    const Node& l = nodes_[i + 1];
+    const Node& r = nodes_[static_cast<std::size_t>(n.first)];
+    for (int k = 0; k < 3; ++k) {
+      n.lo[k] = std::min(l.lo[k], r.lo[k]);
+      n.hi[k] = std::max(l.hi[k], r.hi[k]);
+    }
+    return;
+  }
+  double lo[3], hi[3];
+  for (int k = 0; k < 3; ++k) {
+    lo[k] = std::numeric_limits<double>::infinity();
+    hi[k] = -std::numeric_limits<double>::infinity();
+  }
+  for (std::int32_t f = n.first; f < n.first + n.count; ++f)
+    for (const std::int32_t v : faces_[static_cast<std::size_t>(f)].v)
+      for (int k = 0; k < 3; ++k) {
+        lo[k] = std::min(lo[k], points_[static_cast<std::size_t>(v)][k]);
+        hi[k] = std::max(hi[k], points_[static_cast<std::size_t>(v)][k]);
+      }
+  for (int k = 0; k < 3; ++k) {
+    n.lo[k] = down(lo[k]);
+    n.hi[k] = up(hi[k]);
+  }
+}
+
 void RayCaster::refit(const Mesh& mesh) {
   if (mesh.n_vertices() != points_.size())
     throw InvalidArgument(fmt::format("ray caster: refit with {} vertices; the tree has {}",
                                       mesh.n_vertices(), points_.size()));
-  for (const VertexHandle v : mesh.vertices()) {
-    const Vec3& p = mesh.point(v);
-    if (!std::isfinite(p[0]) || !std::isfinite(p[1]) || !std::isfinite(p[2]))
-      throw InvalidArgument(
-          fmt::format("ray caster: vertex {} is not finite; repair the mesh first", v.idx()));
-    points_[static_cast<std::size_t>(v.idx())] = p;
-  }
+  for (std::size_t v = 0; v < points_.size(); ++v)
+    points_[v] = finite_point(mesh, static_cast<int>(v));
   // Children come after their parent: from the last node back, every child is done first.
-  for (auto i = static_cast<std::ptrdiff_t>(nodes_.size()) - 1; i >= 0; --i) {
-    Node& n = nodes_[static_cast<std::size_t>(i)];
+  for (std::size_t i = nodes_.size(); i-- > 0;) refit_node(i);
+}
+
+void RayCaster::index_for_partial_refit() {
+  parent_.assign(nodes_.size(), -1);
+  slot_leaf_.assign(faces_.size(), -1);
+  for (std::size_t i = 0; i < nodes_.size(); ++i) {
+    const Node& n = nodes_[i];
     if (n.count == 0) {
-      const Node& l = nodes_[static_cast<std::size_t>(i) + 1];
-      const Node& r = nodes_[static_cast<std::size_t>(n.first)];
-      for (int k = 0; k < 3; ++k) {
-        n.lo[k] = std::min(l.lo[k], r.lo[k]);
-        n.hi[k] = std::max(l.hi[k], r.hi[k]);
-      }
-      continue;
-    }
-    double lo[3], hi[3];
-    for (int k = 0; k < 3; ++k) {
-      lo[k] = std::numeric_limits<double>::infinity();
-      hi[k] = -std::numeric_limits<double>::infinity();
-    }
-    for (std::int32_t f = n.first; f < n.first + n.count; ++f)
-      for (const std::int32_t v : faces_[static_cast<std::size_t>(f)].v)
-        for (int k = 0; k < 3; ++k) {
-          lo[k] = std::min(lo[k], points_[static_cast<std::size_t>(v)][k]);
-          hi[k] = std::max(hi[k], points_[static_cast<std::size_t>(v)][k]);
-        }
-    for (int k = 0; k < 3; ++k) {
-      n.lo[k] = down(lo[k]);
-      n.hi[k] = up(hi[k]);
+      parent_[i + 1] = static_cast<std::int32_t>(i);
+      parent_[static_cast<std::size_t>(n.first)] = static_cast<std::int32_t>(i);
+    } else {
+      for (std::int32_t f = n.first; f < n.first + n.count; ++f)
+        slot_leaf_[static_cast<std::size_t>(f)] = static_cast<std::int32_t>(i);
     }
   }
+  vertex_slots_begin_.assign(points_.size() + 1, 0);
+  for (const Face& f : faces_)
+    for (const std::int32_t v : f.v) ++vertex_slots_begin_[static_cast<std::size_t>(v) + 1];
+  for (std::size_t v = 0; v < points_.size(); ++v)
+    vertex_slots_begin_[v + 1] += vertex_slots_begin_[v];
+  vertex_slots_.resize(static_cast<std::size_t>(vertex_slots_begin_.back()));
+  std::vector<std::int32_t> fill(vertex_slots_begin_.begin(), vertex_slots_begin_.end() - 1);
+  for (std::size_t slot = 0; slot < faces_.size(); ++slot)
+    for (const std::int32_t v : faces_[slot].v)
+      vertex_slots_[static_cast<std::size_t>(fill[static_cast<std::size_t>(v)]++)] =
+          static_cast<std::int32_t>(slot);
+}
+
+void RayCaster::refit(const Mesh& mesh, const std::vector<int>& moved) {
+  if (mesh.n_vertices() != points_.size())
+    throw InvalidArgument(fmt::format("ray caster: refit with {} vertices; the tree has {}",
+                                      mesh.n_vertices(), points_.size()));
+  if (parent_.size() != nodes_.size()) index_for_partial_refit();
+  std::vector<std::int32_t> dirty;
+  std::vector<char> marked(nodes_.size(), 0);
+  for (const int v : moved) {
+    if (v < 0 || static_cast<std::size_t>(v) >= points_.size())
+      throw InvalidArgument(fmt::format("ray caster: moved vertex {} is out of range", v));
+    points_[static_cast<std::size_t>(v)] = finite_point(mesh, v);
+    for (std::int32_t s = vertex_slots_begin_[static_cast<std::size_t>(v)];
+         s < vertex_slots_begin_[static_cast<std::size_t>(v) + 1]; ++s)
+      for (std::int32_t node =
+               slot_leaf_[static_cast<std::size_t>(vertex_slots_[static_cast<std::size_t>(s)])];
+           node >= 0 && !marked[static_cast<std::size_t>(node)];
+           node = parent_[static_cast<std::size_t>(node)]) {
+        marked[static_cast<std::size_t>(node)] = 1;
+        dirty.push_back(node);
+      }
+  }
+  // Children have larger indices than their parents: the largest first.
+  std::sort(dirty.begin(), dirty.end(), std::greater<>());
+  for (const std::int32_t i : dirty) refit_node(static_cast<std::size_t>(i));
 }
 
 // Appends to `nodes` the subtree over order[begin, end) (indices into faces_ and centroids):

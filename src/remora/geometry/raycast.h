@@ -43,6 +43,11 @@ public:
   /// The faces left out at construction (zero area) stay out. Throws InvalidArgument if `mesh`
   /// has another number of vertices or a corner that is not finite.
   void refit(const Mesh& mesh);
+  /// The same when only the vertices `moved` (ids) moved: only the leaves holding one of their
+  /// faces and those leaves' ancestors are recomputed, so a drag of a small region costs what the
+  /// region holds. The first call indexes the faces by vertex (twelve bytes per face kept).
+  /// Throws InvalidArgument as refit(mesh) does, or for an id out of range.
+  void refit(const Mesh& mesh, const std::vector<int>& moved);
 
   std::size_t n_faces() const { return faces_.size(); }
 
@@ -56,12 +61,17 @@ private:
     std::int32_t v[3]; // corners, by vertex idx() into points_
     std::int32_t face;
   };
+  void refit_node(std::size_t i); // bounds from its faces (leaf) or its children (inner)
+  void index_for_partial_refit(); // parent_, slot_leaf_, vertex_slots_
   void build(std::vector<Node>& nodes, std::vector<std::int32_t>& order,
              const std::vector<Vec3>& centroids, std::int32_t begin, std::int32_t end,
              bool split) const;
   std::vector<Vec3> points_; // the mesh's vertices
   std::vector<Node> nodes_;
   std::vector<Face> faces_; // in the order of the leaves
+  // For refit(mesh, moved), built on its first call: each node's parent (-1 at the root), each
+  // face slot's leaf, and the face slots around each vertex (CSR).
+  std::vector<std::int32_t> parent_, slot_leaf_, vertex_slots_begin_, vertex_slots_;
 };
 
 } // namespace remora
