@@ -108,7 +108,6 @@ let painting = false, lastHover = null;
 const picks = new Coalescer((q) => pick(q.ray, q.radius, q.brush), onPick);
 
 function onPick(hit, q) {
-  if (q.paint && !painting && q.stroke !== strokeCount) return; // a stroke's late answer after the next began
   lastHover = hit;
   const onMesh = hit.face >= 0 && !!hit.point;
   if (onMesh && state.tool !== 'orbit') view.showCursor(hit.point, faceNormal(state.positions, state.indices, hit.face), panels.radius());
@@ -130,11 +129,10 @@ function paint(ids, tool, label) {
   if (touched.length) { state.dirtyRegion = true; view.colour(state.labels, touched); }
 }
 
-let strokeCount = 0;
 function submitPick(event, paintIt) {
   const tool = state.tool, label = tool === 'support' ? FREE : tool === 'handle' ? state.selected : FIXED;
   picks.submit({ ray: view.rayAt(event), radius: paintIt ? panels.radius() : 0, brush: panels.brush(),
-                 paint: paintIt, tool, label, stroke: strokeCount, t0: performance.now() });
+                 paint: paintIt, tool, label, t0: performance.now() });
 }
 
 // In the capture phase, before the orbit controls: a stroke that starts on the mesh paints, one
@@ -145,7 +143,6 @@ view.container.addEventListener('pointerdown', (event) => {
   message('');
   orbit.enabled = false;
   painting = true;
-  strokeCount += 1;
   submitPick(event, true);
 }, { capture: true });
 view.renderer.domElement.addEventListener('pointermove', (event) => {
@@ -407,6 +404,15 @@ window.remora = {
     return worst;
   },
   marks: () => JSON.parse(JSON.stringify(state.marks)),
+  meshName: () => state.status?.mesh?.name,
+  drawnVertices: () => view.drawnVertices(),
+  /// The largest distance of a drawn normal from the nearest axis direction (a cube's sides).
+  normalOffAxis() {
+    const n = view.normals();
+    let worst = 0;
+    for (let i = 0; i < n.length; i += 3) worst = Math.max(worst, 1 - Math.max(Math.abs(n[i]), Math.abs(n[i + 1]), Math.abs(n[i + 2])));
+    return worst;
+  },
   ready: () => !!view.shown.mesh && work.tasks === 0 && !frames.busy && !picks.busy && state.status?.state === 'ready',
   setTool, setMode,
 };

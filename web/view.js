@@ -5,6 +5,7 @@ import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 import { TransformControls } from 'three/addons/controls/TransformControls.js';
 import { normalPlan, updateNormals } from './normals.js';
+import { splitCreases, withCopies } from './creases.js';
 
 export const FIXED = -2, FREE = -1;
 export const HANDLE_COLORS = [[0.90, 0.30, 0.25], [0.25, 0.55, 0.95], [0.30, 0.80, 0.40], [0.85, 0.45, 0.90],
@@ -61,7 +62,10 @@ const material = new THREE.MeshStandardMaterial({ vertexColors: true, roughness:
 const edgeMaterial = new THREE.MeshBasicMaterial({ color: 0x30343c, wireframe: true });
 /// The drawn objects (null until there is something to draw).
 export const shown = { mesh: null, edges: null, baseLines: null, baseSurface: null };
-let plan = null; // normalPlan() of the current movable vertices
+let plan = null; // normalPlan() of the current movable vertices (display ids)
+// The mesh as drawn: splitCreases() of it, or null when the display is the mesh itself; the mesh's
+// positions (held, not copied); the display copies of the movable vertices.
+let display = null, meshPositions = null, movedCopies = [];
 
 // Frames are drawn on demand (redraw(), or an attribute touched): an idle page costs nothing,
 // and software WebGL does not hold back input events with frames nobody needs.
@@ -101,11 +105,14 @@ renderer.setAnimationLoop(() => {
 /// not copied. The bounding sphere is computed here once; the mesh is never frustum-culled, so a
 /// drag needs no new bounds.
 export function setMesh(positions, indices) {
-  const n = positions.length / 3;
+  display = splitCreases(positions, indices);
+  meshPositions = positions;
+  const drawn = display ? gather(positions, new Float32Array(3 * display.map.length)) : positions;
+  const n = drawn.length / 3;
   const geometry = new THREE.BufferGeometry();
-  geometry.setAttribute('position', new THREE.BufferAttribute(positions, 3));
+  geometry.setAttribute('position', new THREE.BufferAttribute(drawn, 3));
   geometry.setAttribute('color', new THREE.BufferAttribute(new Float32Array(3 * n), 3));
-  geometry.setIndex(new THREE.BufferAttribute(indices, 1));
+  geometry.setIndex(new THREE.BufferAttribute(display ? display.indices : indices, 1));
   geometry.computeVertexNormals();
   geometry.computeBoundingSphere();
   if (shown.mesh) { scene.remove(shown.mesh); scene.remove(shown.edges); shown.mesh.geometry.dispose(); }
@@ -119,9 +126,20 @@ export function setMesh(positions, indices) {
   redraw();
 }
 
+/// The display's positions from the mesh's.
+function gather(positions, out) {
+  const map = display.map;
+  for (let d = 0; d < map.length; ++d) {
+    const v = map[d];
+    out[3 * d] = positions[3 * v]; out[3 * d + 1] = positions[3 * v + 1]; out[3 * d + 2] = positions[3 * v + 2];
+  }
+  return out;
+}
+
 /// Every position changed (undo, redo, a new k): positions.set() was called on the held array.
 export function positionsChanged() {
   const g = shown.mesh.geometry;
+  if (display) gather(meshPositions, g.getAttribute('position').array);
   touch(g.getAttribute('position'));
   g.computeVertexNormals();
   touch(g.getAttribute('normal'));
@@ -130,7 +148,9 @@ export function positionsChanged() {
 /// Prepares applyMoved() for a region's movable vertices (once per region).
 export function setMovable(movable) {
   const g = shown.mesh.geometry;
-  plan = movable ? normalPlan(g.getIndex().array, g.getAttribute('position').count, movable) : null;
+  const ids = movable && display ? withCopies(movable, display.copies) : movable;
+  plan = ids ? normalPlan(g.getIndex().array, g.getAttribute('position').count, ids) : null;
+  movedCopies = ids && display ? ids.slice(movable.length) : [];
 }
 
 /// A drag's frame: moved holds x, y, z for each of movable (setMovable's ids, in that order).
@@ -139,9 +159,14 @@ export function applyMoved(movable, moved) {
   const g = shown.mesh.geometry;
   const position = g.getAttribute('position'), normal = g.getAttribute('normal');
   const p = position.array;
-  for (let i = 0; i < movable.length; ++i) {
-    const v = movable[i];
-    p[3 * v] = moved[3 * i]; p[3 * v + 1] = moved[3 * i + 1]; p[3 * v + 2] = moved[3 * i + 2];
+  for (const q of display ? [meshPositions, p] : [p])
+    for (let i = 0; i < movable.length; ++i) {
+      const v = movable[i];
+      q[3 * v] = moved[3 * i]; q[3 * v + 1] = moved[3 * i + 1]; q[3 * v + 2] = moved[3 * i + 2];
+    }
+  for (const d of movedCopies) {
+    const v = display.map[d];
+    p[3 * d] = meshPositions[3 * v]; p[3 * d + 1] = meshPositions[3 * v + 1]; p[3 * d + 2] = meshPositions[3 * v + 2];
   }
   updateNormals(p, g.getIndex().array, normal.array, plan);
   if (plan.last < plan.first) return;
@@ -158,20 +183,26 @@ export function referenceNormals() {
 }
 export const normals = () => shown.mesh.geometry.getAttribute('normal').array;
 
-/// Colours every vertex by its label (FIXED, FREE, or a handle index), or only the vertices `ids`.
+/// Colours every vertex by its label (FIXED, FREE, or a handle index; labels per mesh vertex), or
+/// only the mesh vertices `ids`.
 export function colour(labels, ids = null) {
   const colours = shown.mesh.geometry.getAttribute('color');
-  const c = colours.array;
-  const set = (v) => { const rgb = labelColour(labels[v]); c[3 * v] = rgb[0]; c[3 * v + 1] = rgb[1]; c[3 * v + 2] = rgb[2]; };
+  const c = colours.array, map = display?.map;
+  const set = (d) => {
+    const rgb = labelColour(labels[map ? map[d] : d]);
+    c[3 * d] = rgb[0]; c[3 * d + 1] = rgb[1]; c[3 * d + 2] = rgb[2];
+  };
   if (ids) {
     let lo = Infinity, hi = -1;
-    for (const v of ids) { set(v); lo = Math.min(lo, v); hi = Math.max(hi, v); }
+    for (const d of display ? withCopies(ids, display.copies) : ids) { set(d); lo = Math.min(lo, d); hi = Math.max(hi, d); }
     if (hi >= 0) touch(colours, lo, hi);
   } else {
-    for (let v = 0; v < labels.length; ++v) set(v);
+    for (let d = 0; d < colours.count; ++d) set(d);
     touch(colours);
   }
 }
+/// The number of vertices drawn (the mesh's, and the copies at creases).
+export const drawnVertices = () => shown.mesh?.geometry.getAttribute('position').count ?? 0;
 
 /// Places the camera to see the whole mesh, or at cameraParam (px,py,pz,tx,ty,tz[,up]); returns
 /// the bounding sphere's radius.

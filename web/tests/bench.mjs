@@ -1,7 +1,8 @@
 // The browser editor's latency, measured in the page (performance.now() marks, window.remora.marks)
 // while the real page is driven with the mouse in headless chromium (SwiftShader WebGL):
 //   ready_ms             server start to a paintable page;
-//   paint_move_ms        one pointer move while painting with a large brush, until its colours are set;
+//   paint_move_ms        one pointer move while painting with a large brush, until its colours are set,
+//                        mesh hidden (paint_move_shown_ms: shown);
 //   mouseup_to_gizmo_ms  the handle stroke's mouse-up to the manipulator on the solved region;
 //   drag_cycle_ms        one manipulator move to its positions and normals applied, mesh hidden
 //                        (software WebGL's drawing not counted); drag_cycle_shown_ms, mesh shown;
@@ -36,13 +37,19 @@ try {
   const bound = await page.evaluate(() => Number(document.getElementById('radius').max));
   const supportRadius = Number(args['support-radius'] ?? bound / 5);
 
-  // The support: a stroke of `moves` pointer moves with the large brush.
+  // The support: strokes of `moves` pointer moves with the large brush, the mesh hidden, then shown.
   await page.keyboard.press('s');
   await page.evaluate((r) => window.remora.setRadius(r), supportRadius);
-  const paintFrom = (await marks()).paintMove.length;
-  await drag(page, centre.x - moves, centre.y, 2, 0, moves);
-  await ready(page);
-  const paintMove = (await marks()).paintMove.slice(paintFrom);
+  const paintStroke = async (dy) => {
+    const from = (await marks()).paintMove.length;
+    await drag(page, centre.x - moves, centre.y + dy, 2, 0, moves);
+    await ready(page);
+    return (await marks()).paintMove.slice(from);
+  };
+  await page.uncheck('#show-mesh');
+  const paintMove = await paintStroke(0);
+  await page.check('#show-mesh');
+  const paintMoveShown = await paintStroke(4);
   // The handle inside it, smaller; its mouse-up sends the region.
   await page.keyboard.press('h');
   await page.evaluate((r) => window.remora.setRadius(r / 4), supportRadius);
@@ -79,10 +86,11 @@ try {
 
   const result = {
     ready_ms: round(paintableAt - started), paint_move_ms: round(median(paintMove)),
+    paint_move_shown_ms: round(median(paintMoveShown)),
     mouseup_to_gizmo_ms: round(mouseupToGizmo), drag_cycle_ms: round(median(hidden.ms)),
     drag_cycle_shown_ms: round(median(shown.ms)), bake_ms: round(bake),
     bytes_per_frame: median([...shown.bytes, ...hidden.bytes]), support_vertices: support,
-    paint_moves: paintMove.length, drag_frames: hidden.ms.length + shown.ms.length,
+    paint_moves: paintMove.length + paintMoveShown.length, drag_frames: hidden.ms.length + shown.ms.length,
   };
   console.log(JSON.stringify(result));
 } catch (e) {

@@ -6,7 +6,8 @@
 // bundled bunny it also checks the editor's rules a new user meets (the manipulator only with the
 // Orbit tool and for a handle the server holds, a handle painted without support, k after a move,
 // the scale clamp, progress and busy buttons, export names, keys after a click, the brush keys,
-// the stats in view), the URL's display options and a broken upload's message.
+// the stats in view), the URL's display options, a cube drawn with sharp creases, and a broken
+// upload's message.
 //
 //   node web/tests/e2e.mjs --cli build/bin/remora --web-root build/web --mesh data/bunny.ply \
 //        --screenshots build/
@@ -16,7 +17,7 @@
 import { join } from 'node:path';
 import { args, check, chromiumOrSkip, client, drag, ready, recordRequests, results, startServer, stroke,
          writeBumpyTorus } from './harness.mjs';
-import { bugChecks, displayOptions, brokenUpload } from './e2e_rules.mjs';
+import { brokenUpload, bugChecks, creases, displayOptions } from './e2e_rules.mjs';
 
 const large = args.large ? Number(args.large) : 0;
 // Where to paint: the bunny's left ear, or the top of the torus (seen from +z).
@@ -152,6 +153,8 @@ try {
   if (!large) {
     await bugChecks.afterRegion(page, log, { api, floats, json }, edit, site);
     await displayOptions(browser, url);
+    await creases(page);
+    await shot(page, 'editor-box.png');
     await brokenUpload(page, args.screenshots);
   }
 } catch (e) {

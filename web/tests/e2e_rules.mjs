@@ -1,8 +1,8 @@
 // The editor's rules a new user meets, checked with the mouse and the keyboard on the bunny
-// (web/tests/e2e.mjs runs them before and after its core edit), the URL's display options, and a
-// broken upload's message.
+// (web/tests/e2e.mjs runs them before and after its core edit), the URL's display options, the
+// creases of a CAD-like part, and a broken upload's message.
 import { join } from 'node:path';
-import { check, drag, ready, stroke } from './harness.mjs';
+import { boxObj, check, drag, ready, stroke } from './harness.mjs';
 
 const remora = (page, what, ...a) => page.evaluate(([w, b]) => {
   const f = window.remora[w];
@@ -227,4 +227,17 @@ export async function brokenUpload(page, screenshots) {
   const text = await page.textContent('#message');
   check(/broken\.ply/.test(text), `a broken upload shows the server's message: "${text.trim()}"`);
   if (screenshots) await page.screenshot({ path: join(screenshots, 'editor-broken-upload.png') });
+}
+
+/// A CAD-like part (a cube of grids) is drawn with sharp creases: its edge vertices are drawn once
+/// per side, and every drawn normal is a side's normal.
+export async function creases(page) {
+  await page.setInputFiles('#file', { name: 'box.obj', mimeType: 'text/plain', buffer: Buffer.from(boxObj(8)) });
+  await page.waitForFunction(() => window.remora.ready() && window.remora.meshName?.() === 'box.obj', null, { timeout: 120000 })
+    .catch(() => {});
+  const drawn = await page.evaluate(() => ({ vertices: window.remora.positionsHeld?.().length / 3,
+    drawn: window.remora.drawnVertices?.(), worst: window.remora.normalOffAxis?.() }));
+  check(drawn.drawn > drawn.vertices && drawn.worst < 1e-6,
+        `a cube is drawn with its creases split: ${drawn.drawn} vertices drawn for ${drawn.vertices}, ` +
+        `normals off the sides' by ${drawn.worst}`);
 }

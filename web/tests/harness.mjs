@@ -121,3 +121,29 @@ export function writeBumpyTorus(path, nu, nv) {
       }
   writeFileSync(path, Buffer.concat([header, vertices, faces]));
 }
+
+/// The text of an OBJ file: the cube [-1, 1]^3 with each side an n x n grid of squares split in
+/// two triangles, vertices shared along the edges (a closed CAD-like part with 90° creases).
+export function boxObj(n) {
+  const ids = new Map(), lines = [];
+  const vertex = (p) => {
+    const key = p.map((x) => x.toFixed(6)).join(' ');
+    if (!ids.has(key)) { ids.set(key, ids.size + 1); lines.push(`v ${key}`); }
+    return ids.get(key);
+  };
+  for (let axis = 0; axis < 3; ++axis)
+    for (const side of [-1, 1]) {
+      const at = (i, j) => {
+        const p = [0, 0, 0];
+        p[axis] = side; p[(axis + 1) % 3] = -1 + 2 * i / n; p[(axis + 2) % 3] = -1 + 2 * j / n;
+        return vertex(p);
+      };
+      for (let i = 0; i < n; ++i)
+        for (let j = 0; j < n; ++j) {
+          const [a, b, c, d] = [at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)];
+          // Outward: counter-clockwise seen from outside.
+          lines.push(side > 0 ? `f ${a} ${b} ${c}\nf ${a} ${c} ${d}` : `f ${a} ${c} ${b}\nf ${a} ${d} ${c}`);
+        }
+    }
+  return lines.join('\n') + '\n';
+}
