@@ -215,6 +215,18 @@ TEST(ServerEditing, AJobsProgressRunsForwardToTheEnd) {
   EXPECT_GT(seen.back(), 0.5);
 }
 
+TEST(ServerEditing, ALongPollOfTheStatusAnswersWhenTheJobEnds) {
+  Session s;
+  expect_error(call(s, "GET", "/api/status", "", {{"wait", "soon"}}), 400, "wait");
+  expect_error(call(s, "GET", "/api/status", "", {{"wait", "20000"}}), 400, "wait");
+  ASSERT_EQ(call(s, "POST", "/api/load", sphere_off(), {{"name", "sphere.off"}}).status, 202);
+  // One poll of up to 10 s answers once the job has ended: ready, not busy.
+  EXPECT_EQ(json::parse(call(s, "GET", "/api/status", "", {{"wait", "10000"}}).body)["state"],
+            "ready");
+  // Idle: no wait at all.
+  EXPECT_EQ(json::parse(call(s, "GET", "/api/status", "", {{"wait", "0"}}).body)["state"], "ready");
+}
+
 /// `remora serve`'s binding on a free loopback port, with a client.
 class Loopback {
 public:

@@ -58,12 +58,12 @@ export const post = (path, body) => api(path, { method: 'POST', headers: { 'Cont
 /// returns the first other status. A job's error (status.error) is shown.
 export async function waitUntilReady(onBusy) {
   for (;;) {
-    const s = await json('status');
+    // A long poll: the server answers as soon as the job ends, else after 200 ms with its progress.
+    const s = await json('status?wait=200');
     if (s.state !== 'busy') {
       if (s.error) message(s.error);
       return s;
     }
     onBusy(s);
-    await new Promise((r) => setTimeout(r, 150));
   }
 }

@@ -404,6 +404,7 @@ window.remora = {
     return worst;
   },
   marks: () => JSON.parse(JSON.stringify(state.marks)),
+  setDrawing: (on) => view.setDrawing(on),
   meshName: () => state.status?.mesh?.name,
   drawnVertices: () => view.drawnVertices(),
   /// The largest distance of a drawn normal from the nearest axis direction (a cube's sides).

@@ -69,8 +69,11 @@ let display = null, meshPositions = null, movedCopies = [];
 
 // Frames are drawn on demand (redraw(), or an attribute touched): an idle page costs nothing,
 // and software WebGL does not hold back input events with frames nobody needs.
-let dirty = true;
+let dirty = true, drawing = true;
 export function redraw() { dirty = true; }
+/// Off: nothing is drawn (changes wait until it is on again). The browser benchmark measures the
+/// page's own work this way, without software WebGL's drawing.
+export function setDrawing(on) { drawing = on; dirty = true; }
 
 function resize() {
   const w = container.clientWidth, h = container.clientHeight;
@@ -90,7 +93,7 @@ function touch(attribute, lo = null, hi = null) {
   touched.set(attribute, old ? { lo: Math.min(old.lo, lo), hi: Math.max(old.hi, hi) } : { lo, hi });
 }
 renderer.setAnimationLoop(() => {
-  if (!dirty && touched.size === 0) return;
+  if (!drawing || (!dirty && touched.size === 0)) return;
   dirty = false;
   for (const [attribute, range] of touched) {
     attribute.clearUpdateRanges();

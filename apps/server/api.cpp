@@ -1,6 +1,8 @@
 #include "api.h"
 
 #include <cctype>
+#include <charconv>
+#include <chrono>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -190,7 +192,20 @@ HttpResponse dispatch(Session& session, const HttpRequest& q, const ApiLimits& l
   };
   auto get_only = [&] { need("GET", "GET"); };
   auto post_only = [&] { need("POST", "POST"); };
-  if (p == "/api/status") return get_only(), json_response(200, session.status());
+  if (p == "/api/status") {
+    get_only();
+    // ?wait=MS: a long poll, answered when the job ends or after MS milliseconds.
+    if (const auto w = q.query.find("wait"); w != q.query.end()) {
+      int ms = -1;
+      const auto [end, error] =
+          std::from_chars(w->second.data(), w->second.data() + w->second.size(), ms);
+      if (error != std::errc() || end != w->second.data() + w->second.size() || ms < 0 ||
+          ms > 10000)
+        throw BadRequest("wait: expected milliseconds from 0 to 10000");
+      session.wait_for(std::chrono::milliseconds(ms));
+    }
+    return json_response(200, session.status());
+  }
   if (p == "/api/load") {
     post_only();
     const auto name = q.query.find("name");

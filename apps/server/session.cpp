@@ -183,6 +183,11 @@ void Session::wait() {
   impl_->idle.wait(lock, [&] { return !impl_->busy; });
 }
 
+void Session::wait_for(std::chrono::milliseconds timeout) {
+  std::unique_lock lock(impl_->mutex);
+  impl_->idle.wait_for(lock, timeout, [&] { return !impl_->busy; });
+}
+
 void Session::start_load(std::string bytes, std::string name) {
   std::lock_guard lock(impl_->mutex);
   const MeshFormat format = format_from_path(name); // IoError for an unknown extension at once

@@ -10,6 +10,7 @@
 // result into a new editor (the edited shape becomes the next input), as a user expects.
 #pragma once
 
+#include <chrono>
 #include <condition_variable>
 #include <cstddef>
 #include <memory>
@@ -59,6 +60,9 @@ public:
   void start_region(std::vector<int> support, std::vector<std::vector<int>> handles, int k);
   /// Blocks until the worker is idle (tests and the CLI).
   void wait();
+  /// Blocks until the worker is idle or `timeout` has passed (a client's long poll of the
+  /// status: it learns of the end of a job at once, without polling fast).
+  void wait_for(std::chrono::milliseconds timeout);
 
   /// Moves handle j (live: not in the history until commit()). Returns the positions of
   /// movable_vertices(), in that order, and the frame time in milliseconds.

@@ -2,10 +2,14 @@
 // while the real page is driven with the mouse in headless chromium (SwiftShader WebGL):
 //   ready_ms             server start to a paintable page;
 //   paint_move_ms        one pointer move while painting with a large brush, until its colours are set,
-//                        mesh hidden (paint_move_shown_ms: shown);
-//   mouseup_to_gizmo_ms  the handle stroke's mouse-up to the manipulator on the solved region;
-//   drag_cycle_ms        one manipulator move to its positions and normals applied, mesh hidden
-//                        (software WebGL's drawing not counted); drag_cycle_shown_ms, mesh shown;
+//                        nothing drawn (software WebGL's drawing not counted; paint_move_shown_ms:
+//                        drawn);
+//   mouseup_to_gizmo_ms  the handle stroke's mouse-up to the manipulator on the solved region,
+//                        nothing drawn;
+//                        set_region_ms, the server's part of it, and the rest,
+//                        mouseup_to_gizmo_beyond_set_region_ms;
+//   drag_cycle_ms        one manipulator move to its positions and normals applied, nothing drawn;
+//                        drag_cycle_shown_ms, drawn;
 //   bake_ms              a new stroke after a move (the edited shape baked, a new region) until paintable;
 //   bytes_per_frame      the transform answer's size; support_vertices, the region's support.
 // All medians. The last line printed is one JSON object with these keys.
@@ -46,18 +50,22 @@ try {
     await ready(page);
     return (await marks()).paintMove.slice(from);
   };
-  await page.uncheck('#show-mesh');
+  await page.evaluate(() => window.remora.setDrawing(false));
   const paintMove = await paintStroke(0);
-  await page.check('#show-mesh');
+  await page.evaluate(() => window.remora.setDrawing(true));
   const paintMoveShown = await paintStroke(4);
   // The handle inside it, smaller; its mouse-up sends the region.
   await page.keyboard.press('h');
   await page.evaluate((r) => window.remora.setRadius(r / 4), supportRadius);
+  await page.evaluate(() => window.remora.setDrawing(false));
   await drag(page, centre.x, centre.y, 1, 0, 3);
   await ready(page, 600000);
+  await page.evaluate(() => window.remora.setDrawing(true));
   let m = await marks();
   const mouseupToGizmo = m.regionReady[m.regionReady.length - 1] - m.strokeEnd;
-  const support = (await json('status')).region?.support ?? 0;
+  const regionStatus = (await json('status')).region ?? {};
+  const support = regionStatus.support ?? 0;
+  const setRegion = regionStatus.set_region_ms ?? null;
 
   // Drags of the manipulator's arrow, the mesh shown, then hidden.
   const dragCycle = async () => {
@@ -71,9 +79,9 @@ try {
     return { ms: mm.drag.slice(from), bytes: mm.dragBytes.slice(from) };
   };
   const shown = await dragCycle();
-  await page.uncheck('#show-mesh');
+  await page.evaluate(() => window.remora.setDrawing(false));
   const hidden = await dragCycle();
-  await page.check('#show-mesh');
+  await page.evaluate(() => window.remora.setDrawing(true));
 
   // A new support stroke after the move: the edited shape is baked into a new base.
   await page.keyboard.press('s');
@@ -87,7 +95,9 @@ try {
   const result = {
     ready_ms: round(paintableAt - started), paint_move_ms: round(median(paintMove)),
     paint_move_shown_ms: round(median(paintMoveShown)),
-    mouseup_to_gizmo_ms: round(mouseupToGizmo), drag_cycle_ms: round(median(hidden.ms)),
+    mouseup_to_gizmo_ms: round(mouseupToGizmo), set_region_ms: round(setRegion),
+    mouseup_to_gizmo_beyond_set_region_ms: round(setRegion === null ? null : mouseupToGizmo - setRegion),
+    drag_cycle_ms: round(median(hidden.ms)),
     drag_cycle_shown_ms: round(median(shown.ms)), bake_ms: round(bake),
     bytes_per_frame: median([...shown.bytes, ...hidden.bytes]), support_vertices: support,
     paint_moves: paintMove.length + paintMoveShown.length, drag_frames: hidden.ms.length + shown.ms.length,
