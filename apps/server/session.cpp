@@ -45,8 +45,8 @@ bool is_identity(const std::vector<Transform>& transforms) {
 }
 
 /// Where a phase of the editor's preprocessing sits in the whole of it, as [begin, end)
-/// fractions: shares of the wall time of the bundled bunny's and igea_sub4's preprocessing, an
-/// estimate for other meshes (the bar moves on, it does not promise a time).
+/// fractions: a rough split (igea_sub4 spends about a quarter in the base surface and the rest in
+/// the remesh); the bar moves forward, it does not promise a time.
 std::pair<double, double> preprocess_share(std::string_view phase) {
   if (phase == "reading") return {0.0, 0.05};
   if (phase == "base surface") return {0.05, 0.2};

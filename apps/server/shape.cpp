@@ -18,7 +18,9 @@ Brush parse_brush(const std::string& name) {
   throw InvalidArgument(fmt::format("unknown brush '{}': use geodesic or sphere", name));
 }
 
-Shape::Shape(const Mesh& mesh) : mesh_(mesh), marching_(mesh_) {}
+// The caster is built here, on the load's worker, not on the first pick (half a second on a
+// million triangles).
+Shape::Shape(const Mesh& mesh) : mesh_(mesh), caster_(mesh_), marching_(mesh_) {}
 
 void Shape::set_positions(const Eigen::MatrixXd& positions) {
   for (const VertexHandle v : mesh_.vertices())
@@ -40,17 +42,15 @@ void Shape::set_positions(const std::vector<int>& ids, const Eigen::MatrixXd& po
 Pick Shape::pick(const Vec3& origin, const Vec3& direction, double radius, Brush brush) {
   if (!(radius >= 0.0) || !std::isfinite(radius))
     throw InvalidArgument(fmt::format("radius: {} must be finite and >= 0", radius));
-  if (!caster_)
-    caster_.emplace(mesh_);
-  else if (stale_)
-    caster_->refit(mesh_);
+  if (stale_)
+    caster_.refit(mesh_);
   else if (!moved_.empty())
-    caster_->refit(mesh_, moved_); // a drag moved only its region
+    caster_.refit(mesh_, moved_); // a drag moved only its region
   stale_ = false;
   for (const int i : moved_) moved_flag_[static_cast<std::size_t>(i)] = 0;
   moved_.clear();
   const RayHit hit =
-      caster_->first_hit(origin, direction, 0.0, std::numeric_limits<double>::infinity());
+      caster_.first_hit(origin, direction, 0.0, std::numeric_limits<double>::infinity());
   Pick out;
   if (!hit.face.is_valid()) return out;
   const SurfacePoint at{hit.face, hit.bary};

@@ -4,7 +4,6 @@
 #pragma once
 
 #include <cstdint>
-#include <optional>
 #include <string>
 #include <vector>
 
@@ -31,7 +30,8 @@ struct Pick {
 
 class Shape {
 public:
-  /// Copies the mesh (its faces and current positions).
+  /// Copies the mesh (its faces and current positions) and builds the ray caster over it.
+  /// Throws InvalidArgument for a corner that is not finite.
   explicit Shape(const Mesh& mesh);
 
   /// Every vertex moves to the rows of `positions` (n_vertices × 3).
@@ -48,8 +48,8 @@ public:
 
 private:
   Mesh mesh_;
-  std::optional<RayCaster> caster_;
-  bool stale_ = true;      // every vertex may have moved since the caster's last refit
+  RayCaster caster_;
+  bool stale_ = false;     // every vertex may have moved since the caster's last refit
   std::vector<int> moved_; // else these did (each once)
   std::vector<char> moved_flag_;
   FastMarching marching_;
