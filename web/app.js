@@ -36,9 +36,9 @@ const MIN_SCALE = 0.05; // the manipulator's smallest scale per axis: the map ke
 const state = {
   tool: 'orbit', selected: 0, handleCount: 1, k: 2,
   labels: null, positions: null, indices: null, // labels: FIXED, FREE or a handle index per vertex
-  movable: null, serverHandles: 0, transforms: [], dirtyRegion: false, status: null, frameMs: undefined,
+  movable: null, sentMovable: null, serverHandles: 0, transforms: [], dirtyRegion: false, status: null, frameMs: undefined,
   held: { mesh: undefined, positions: undefined, region: undefined }, // the status ids of what the page holds
-  marks: { paintMove: [], drag: [], dragBytes: [], regionReady: [], strokeEnd: null, paintable: null },
+  marks: { paintMove: [], paintTrip: [], drag: [], dragBytes: [], regionReady: [], regionSteps: [], strokeEnd: null, paintable: null },
 };
 const busy = () => state.status?.state === 'busy';
 
@@ -98,14 +98,21 @@ async function fetchRegion(s, labelsKnown) {
     view.colour(state.labels);
   }
   state.serverHandles = s.region?.handles ?? 0;
-  state.movable = s.region ? await binary('movable', Uint32Array) : null;
-  view.setMovable(state.movable);
+  if (labelsKnown && s.region && state.sentMovable) {
+    // The movable vertices are the support the page sent (sorted, handles included); its normal
+    // plan was made while the server solved.
+    state.movable = state.sentMovable;
+  } else {
+    state.movable = s.region ? await binary('movable', Uint32Array) : null;
+    view.setMovable(state.movable);
+  }
+  state.sentMovable = null;
   state.held.region = s.region_id;
 }
 
 // ---- painting: the server picks, the page colours -----------------------------------------------
 let painting = false, lastHover = null;
-const picks = new Coalescer((q) => pick(q.ray, q.radius, q.brush), onPick);
+const picks = new Coalescer((q) => { q.sent = performance.now(); return pick(q.ray, q.radius, q.brush); }, onPick);
 
 function onPick(hit, q) {
   lastHover = hit;
@@ -113,6 +120,7 @@ function onPick(hit, q) {
   if (onMesh && state.tool !== 'orbit') view.showCursor(hit.point, faceNormal(state.positions, state.indices, hit.face), panels.radius());
   else view.hideCursor();
   if (q.paint && onMesh) {
+    state.marks.paintTrip.push(performance.now() - q.sent);
     paint(hit.ids, q.tool, q.label);
     state.marks.paintMove.push(performance.now() - q.t0);
   }
@@ -164,18 +172,24 @@ window.addEventListener('pointerup', () => {
 /// The painted region as the API takes it; handles are renumbered so that none is empty (the
 /// labels follow), and `free` counts the support's vertices outside every handle.
 function regionLists() {
-  const counts = new Array(state.handleCount).fill(0);
+  // One index loop over the typed array (it runs once per stroke over every vertex, mostly
+  // before the JIT has optimized it), then one over the support.
+  const labels = state.labels, n = labels.length;
+  const counts = new Array(state.handleCount).fill(0), support = [];
   let free = 0;
-  for (const l of state.labels) if (l >= 0) counts[l] += 1; else if (l === FREE) free += 1;
-  const renumber = [];
-  counts.forEach((c, j) => { renumber[j] = c > 0 ? renumber.filter((x) => x >= 0).length : -1; });
-  const kept = renumber.filter((x) => x >= 0).length;
-  const support = [], handles = Array.from({ length: kept }, () => []);
-  for (let v = 0; v < state.labels.length; ++v) {
-    const l = state.labels[v];
+  for (let v = 0; v < n; ++v) {
+    const l = labels[v];
     if (l === FIXED) continue;
     support.push(v);
-    if (l >= 0) { state.labels[v] = renumber[l]; handles[renumber[l]].push(v); }
+    if (l >= 0) counts[l] += 1; else free += 1;
+  }
+  const renumber = [];
+  let kept = 0;
+  counts.forEach((c, j) => { renumber[j] = c > 0 ? kept++ : -1; });
+  const handles = Array.from({ length: kept }, () => []);
+  for (let i = 0; i < support.length; ++i) {
+    const v = support[i], l = labels[v];
+    if (l >= 0) { labels[v] = renumber[l]; handles[renumber[l]].push(v); }
   }
   if (renumber.some((x, j) => x !== j)) view.colour(state.labels);
   if (kept > 0) {
@@ -188,6 +202,7 @@ function regionLists() {
 /// Sends the painted region when it can be solved; otherwise says what is missing. A refusal
 /// (a 4xx or the job's error) keeps the paint and shows the server's message.
 async function sendRegion({ keepGizmo = false } = {}) {
+  const started = performance.now();
   state.dirtyRegion = false;
   const { support, handles, free } = regionLists();
   showHandleButtons();
@@ -201,11 +216,26 @@ async function sendRegion({ keepGizmo = false } = {}) {
     return;
   }
   if (busy()) await settle();
+  const steps = { started, lists: performance.now() };
+  const posted = post('region', { support, handles, k: state.k });
+  // While the request travels and the server solves: the normal plan of the region sent (its
+  // movable vertices are the support, handles included, sorted).
+  state.sentMovable = Uint32Array.from(support);
+  view.setMovable(state.sentMovable);
+  steps.planned = performance.now();
   try {
-    panels.showProgress(await (await post('region', { support, handles, k: state.k })).json());
-  } catch (e) { return; }
+    panels.showProgress(await (await posted).json());
+  } catch (e) {
+    state.sentMovable = null;
+    view.setMovable(state.movable);
+    return;
+  }
+  steps.posted = performance.now();
   const s = await settle();
+  steps.settled = performance.now();
   if (s.error) {
+    state.sentMovable = null;
+    view.setMovable(state.movable);
     state.status = s;
     panels.showStats(s, state.frameMs);
     state.dirtyRegion = true;
@@ -213,7 +243,10 @@ async function sendRegion({ keepGizmo = false } = {}) {
     return;
   }
   await sync(s, { labelsKnown: true, keepGizmo });
+  state.sentMovable = null;
   state.marks.regionReady.push(performance.now());
+  for (const key of Object.keys(steps)) steps[key] -= state.marks.strokeEnd;
+  state.marks.regionSteps.push(steps);
   if (!keepGizmo) {
     setTool('orbit');
     message('Region ready; the Orbit tool is on: drag the arrows to move the handle (S, H: paint again).', 'info');
@@ -394,6 +427,7 @@ window.remora = {
                   cursor: view.cursorShown(), cursorRadius: view.cursorRadius() }),
   labels: () => Array.from(state.labels ?? []),
   positionsHeld: () => state.positions,
+  indicesHeld: () => state.indices,
   tool: () => state.tool,
   selected: () => state.selected,
   /// The largest difference between the page's normals and three.js's full computeVertexNormals().

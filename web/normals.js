@@ -3,25 +3,49 @@
 // normals (c - b) x (a - b) over a vertex's faces, then normalized), evaluated only where a moved
 // vertex can change it. web/tests/e2e.mjs checks the result against computeVertexNormals().
 
-/// The work of one region, computed once: `vertices`, the vertices whose normal depends on a
-/// movable vertex (the corners of every face touching one), sorted; `faces`, every face touching
-/// one of those (their normals are the sums); `first`, `last`, the smallest and largest of
-/// `vertices` (the attribute range to upload). indices: Uint32 triples; movable: vertex ids.
-export function normalPlan(indices, vertexCount, movable) {
-  const moves = new Uint8Array(vertexCount);
-  for (const v of movable) moves[v] = 1;
-  const affected = new Uint8Array(vertexCount);
-  for (let f = 0; f < indices.length; f += 3) {
-    const a = indices[f], b = indices[f + 1], c = indices[f + 2];
-    if (moves[a] || moves[b] || moves[c]) { affected[a] = 1; affected[b] = 1; affected[c] = 1; }
+/// The faces around each vertex, built once per mesh: faces(v) are the face offsets (3 f) in
+/// faces[begin[v] .. begin[v + 1]). indices: Uint32 triples.
+export function vertexFaces(indices, vertexCount) {
+  const begin = new Uint32Array(vertexCount + 1);
+  for (let i = 0; i < indices.length; ++i) begin[indices[i] + 1] += 1;
+  for (let v = 0; v < vertexCount; ++v) begin[v + 1] += begin[v];
+  const fill = begin.slice(0, vertexCount), faces = new Uint32Array(indices.length);
+  for (let i = 0; i < indices.length; ++i) faces[fill[indices[i]]++] = i - (i % 3);
+  return { begin, faces };
+}
+
+/// The work of one region, computed once from the faces around its vertices (vertexFaces()):
+/// `vertices`, the vertices whose normal depends on a movable vertex (the corners of every face
+/// touching one), sorted; `faces`, every face touching one of those (their normals are the
+/// sums); `first`, `last`, the smallest and largest of `vertices` (the attribute range to
+/// upload); `affected`, 1 for each of `vertices`. indices: Uint32 triples; movable: vertex ids.
+export function normalPlan(indices, around, movable) {
+  // Plain index loops over typed arrays: this runs once per region, mostly before the JIT has
+  // optimized it, where closures and iterators cost several times more.
+  const { begin, faces: ring } = around;
+  const vertexCount = begin.length - 1;
+  const affected = new Uint8Array(vertexCount), list = new Uint32Array(vertexCount);
+  let count = 0;
+  for (let i = 0; i < movable.length; ++i) {
+    const v = movable[i];
+    for (let k = begin[v], end = begin[v + 1]; k < end; ++k)
+      for (let c = ring[k], last = c + 3; c < last; ++c) {
+        const w = indices[c];
+        if (affected[w] === 0) { affected[w] = 1; list[count++] = w; }
+      }
   }
-  const faces = [];
-  for (let f = 0; f < indices.length; f += 3)
-    if (affected[indices[f]] || affected[indices[f + 1]] || affected[indices[f + 2]]) faces.push(f);
-  const vertices = [];
-  for (let v = 0; v < vertexCount; ++v) if (affected[v]) vertices.push(v);
-  return { vertices: Uint32Array.from(vertices), faces: Uint32Array.from(faces), affected,
-           first: vertices.length ? vertices[0] : 0, last: vertices.length ? vertices[vertices.length - 1] : -1 };
+  const seen = new Uint8Array(indices.length / 3), faceList = new Uint32Array(indices.length / 3);
+  let faceCount = 0;
+  for (let i = 0; i < count; ++i) {
+    const v = list[i];
+    for (let k = begin[v], end = begin[v + 1]; k < end; ++k) {
+      const f = ring[k], t = (f / 3) | 0;
+      if (seen[t] === 0) { seen[t] = 1; faceList[faceCount++] = f; }
+    }
+  }
+  const vertices = list.slice(0, count).sort();
+  return { vertices, faces: faceList.slice(0, faceCount).sort(), affected,
+           first: count ? vertices[0] : 0, last: count ? vertices[count - 1] : -1 };
 }
 
 /// Recomputes normals[3v..3v+2] for every v in plan.vertices from positions (Float32 x, y, z per

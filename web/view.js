@@ -4,7 +4,7 @@
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 import { TransformControls } from 'three/addons/controls/TransformControls.js';
-import { normalPlan, updateNormals } from './normals.js';
+import { normalPlan, updateNormals, vertexFaces } from './normals.js';
 import { splitCreases, withCopies } from './creases.js';
 
 export const FIXED = -2, FREE = -1;
@@ -59,10 +59,23 @@ export function detachGizmo() { gizmo.detach(); showGizmo(false); }
 const material = new THREE.MeshStandardMaterial({ vertexColors: true, roughness: 0.75, metalness: 0.0,
                                                   side: THREE.DoubleSide,
                                                   polygonOffset: true, polygonOffsetFactor: 1, polygonOffsetUnits: 1 });
+// Region colours stop half-way between a painted and an unpainted corner (where a corner's
+// weight passes 1/2), not at the far corner: on a CAD part's large faces a painted corner would
+// otherwise tint the whole face. `painted` is 1 at a painted vertex, 0 elsewhere; the unpainted
+// corners all have FIXED_RGB, so vColor minus their share is the painted corners' mix.
+material.onBeforeCompile = (shader) => {
+  shader.uniforms.fixedColour = { value: new THREE.Vector3(...FIXED_RGB) };
+  shader.vertexShader = 'attribute float painted;\nvarying float vPainted;\n' +
+    shader.vertexShader.replace('#include <color_vertex>', '#include <color_vertex>\n  vPainted = painted;');
+  shader.fragmentShader = 'uniform vec3 fixedColour;\nvarying float vPainted;\n' +
+    shader.fragmentShader.replace('#include <color_fragment>', `
+      diffuseColor.rgb *= vPainted < 0.5 ? fixedColour : (vColor - (1.0 - vPainted) * fixedColour) / vPainted;`);
+};
 const edgeMaterial = new THREE.MeshBasicMaterial({ color: 0x30343c, wireframe: true });
 /// The drawn objects (null until there is something to draw).
 export const shown = { mesh: null, edges: null, baseLines: null, baseSurface: null };
 let plan = null; // normalPlan() of the current movable vertices (display ids)
+let around = null; // vertexFaces() of the drawn mesh
 // The mesh as drawn: splitCreases() of it, or null when the display is the mesh itself; the mesh's
 // positions (held, not copied); the display copies of the movable vertices.
 let display = null, meshPositions = null, movedCopies = [];
@@ -115,6 +128,7 @@ export function setMesh(positions, indices) {
   const geometry = new THREE.BufferGeometry();
   geometry.setAttribute('position', new THREE.BufferAttribute(drawn, 3));
   geometry.setAttribute('color', new THREE.BufferAttribute(new Float32Array(3 * n), 3));
+  geometry.setAttribute('painted', new THREE.BufferAttribute(new Float32Array(n), 1));
   geometry.setIndex(new THREE.BufferAttribute(display ? display.indices : indices, 1));
   geometry.computeVertexNormals();
   geometry.computeBoundingSphere();
@@ -126,6 +140,10 @@ export function setMesh(positions, indices) {
   scene.add(shown.mesh);
   scene.add(shown.edges);
   plan = null;
+  around = vertexFaces(geometry.getIndex().array, n);
+  // A first plan, thrown away, so that the JIT has compiled normalPlan() before the first region
+  // (the first call runs two to three times slower).
+  normalPlan(geometry.getIndex().array, around, new Uint32Array(Math.min(n, 20000)).map((_, i) => i));
   redraw();
 }
 
@@ -152,7 +170,7 @@ export function positionsChanged() {
 export function setMovable(movable) {
   const g = shown.mesh.geometry;
   const ids = movable && display ? withCopies(movable, display.copies) : movable;
-  plan = ids ? normalPlan(g.getIndex().array, g.getAttribute('position').count, ids) : null;
+  plan = ids ? normalPlan(g.getIndex().array, around, ids) : null;
   movedCopies = ids && display ? ids.slice(movable.length) : [];
 }
 
@@ -189,19 +207,21 @@ export const normals = () => shown.mesh.geometry.getAttribute('normal').array;
 /// Colours every vertex by its label (FIXED, FREE, or a handle index; labels per mesh vertex), or
 /// only the mesh vertices `ids`.
 export function colour(labels, ids = null) {
-  const colours = shown.mesh.geometry.getAttribute('color');
-  const c = colours.array, map = display?.map;
+  const colours = shown.mesh.geometry.getAttribute('color'), painted = shown.mesh.geometry.getAttribute('painted');
+  const c = colours.array, p = painted.array, map = display?.map;
   const set = (d) => {
-    const rgb = labelColour(labels[map ? map[d] : d]);
+    const label = labels[map ? map[d] : d], rgb = labelColour(label);
     c[3 * d] = rgb[0]; c[3 * d + 1] = rgb[1]; c[3 * d + 2] = rgb[2];
+    p[d] = label === FIXED ? 0 : 1;
   };
   if (ids) {
     let lo = Infinity, hi = -1;
     for (const d of display ? withCopies(ids, display.copies) : ids) { set(d); lo = Math.min(lo, d); hi = Math.max(hi, d); }
-    if (hi >= 0) touch(colours, lo, hi);
+    if (hi >= 0) { touch(colours, lo, hi); touch(painted, lo, hi); }
   } else {
     for (let d = 0; d < colours.count; ++d) set(d);
     touch(colours);
+    touch(painted);
   }
 }
 /// The number of vertices drawn (the mesh's, and the copies at creases).

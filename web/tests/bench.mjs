@@ -3,7 +3,7 @@
 //   ready_ms             server start to a paintable page;
 //   paint_move_ms        one pointer move while painting with a large brush, until its colours are set,
 //                        nothing drawn (software WebGL's drawing not counted; paint_move_shown_ms:
-//                        drawn);
+//                        drawn; paint_pick_round_trip_ms: the pick request's part of it);
 //   mouseup_to_gizmo_ms  the handle stroke's mouse-up to the manipulator on the solved region,
 //                        nothing drawn;
 //                        set_region_ms, the server's part of it, and the rest,
@@ -12,16 +12,21 @@
 //                        drag_cycle_shown_ms, drawn;
 //   bake_ms              a new stroke after a move (the edited shape baked, a new region) until paintable;
 //   bytes_per_frame      the transform answer's size; support_vertices, the region's support.
-// All medians. The last line printed is one JSON object with these keys.
+// The pointer moves one step per 1/60 s (a browser delivers moves once per display frame). All
+// medians. The last line printed is one JSON object with these keys.
 //
 //   node web/tests/bench.mjs --cli build/bin/remora --web-root build/web [--mesh data/bunny.ply]
-//        [--support-radius R] [--moves N]
+//        [--support-radius R] [--moves N] [--quick]
 // R is in the mesh's units (default: a fifth of its bounding radius); the support is painted at
-// the surface under the view's centre. Exit code 0: done, 1: failed, 77: chromium or
-// playwright-core missing.
+// the surface under the view's centre. --quick: no drawn figures and no bake (their keys are
+// null). Exit code 0: done, 1: failed, 77: chromium or playwright-core missing.
 import { args, chromiumOrSkip, client, drag, ready, startServer } from './harness.mjs';
 
 const moves = Number(args.moves ?? 30);
+const quick = 'quick' in args;
+// Pointer moves come one per display frame at 60 Hz, as a browser delivers them (it aligns them
+// with its frames), not as fast as the driver can send them.
+const frame = 1000 / 60;
 const median = (xs) => { const s = [...xs].sort((a, b) => a - b); return s.length ? s[s.length >> 1] : null; };
 const round = (x) => (x === null ? null : Math.round(x * 100) / 100);
 
@@ -46,14 +51,15 @@ try {
   await page.evaluate((r) => window.remora.setRadius(r), supportRadius);
   const paintStroke = async (dy) => {
     const from = (await marks()).paintMove.length;
-    await drag(page, centre.x - moves, centre.y + dy, 2, 0, moves);
+    await drag(page, centre.x - moves, centre.y + dy, 2, 0, moves, frame);
     await ready(page);
-    return (await marks()).paintMove.slice(from);
+    const mm = await marks();
+    return { ms: mm.paintMove.slice(from), trips: mm.paintTrip.slice(from) };
   };
   await page.evaluate(() => window.remora.setDrawing(false));
-  const paintMove = await paintStroke(0);
+  const { ms: paintMove, trips: paintTrips } = await paintStroke(0);
   await page.evaluate(() => window.remora.setDrawing(true));
-  const paintMoveShown = await paintStroke(4);
+  const { ms: paintMoveShown } = quick ? { ms: [] } : await paintStroke(4);
   // The handle inside it, smaller; its mouse-up sends the region.
   await page.keyboard.press('h');
   await page.evaluate((r) => window.remora.setRadius(r / 4), supportRadius);
@@ -63,6 +69,7 @@ try {
   await page.evaluate(() => window.remora.setDrawing(true));
   let m = await marks();
   const mouseupToGizmo = m.regionReady[m.regionReady.length - 1] - m.strokeEnd;
+  console.log('region steps', JSON.stringify(m.regionSteps[m.regionSteps.length - 1]));
   const regionStatus = (await json('status')).region ?? {};
   const support = regionStatus.support ?? 0;
   const setRegion = regionStatus.set_region_ms ?? null;
@@ -73,12 +80,12 @@ try {
     const pivot = await page.evaluate(() => window.remora.pivot());
     const c = await page.evaluate((p) => window.remora.projectPoint(...p), pivot);
     await page.keyboard.press('w');
-    await drag(page, c.x, c.y - 75, 0, -1, moves);
+    await drag(page, c.x, c.y - 75, 0, -1, moves, frame);
     await ready(page);
     const mm = await marks();
     return { ms: mm.drag.slice(from), bytes: mm.dragBytes.slice(from) };
   };
-  const shown = await dragCycle();
+  const shown = quick ? { ms: [], bytes: [] } : await dragCycle();
   await page.evaluate(() => window.remora.setDrawing(false));
   const hidden = await dragCycle();
   await page.evaluate(() => window.remora.setDrawing(true));
@@ -87,14 +94,16 @@ try {
   await page.keyboard.press('s');
   await page.evaluate((r) => window.remora.setRadius(1.3 * r), supportRadius);
   const regions = m.regionReady.length;
-  await drag(page, centre.x, centre.y, 1, 1, 3);
-  await ready(page, 600000);
-  m = await marks();
+  if (!quick) {
+    await drag(page, centre.x, centre.y, 1, 1, 3);
+    await ready(page, 600000);
+    m = await marks();
+  }
   const bake = m.regionReady.length > regions ? m.regionReady[m.regionReady.length - 1] - m.strokeEnd : null;
 
   const result = {
     ready_ms: round(paintableAt - started), paint_move_ms: round(median(paintMove)),
-    paint_move_shown_ms: round(median(paintMoveShown)),
+    paint_move_shown_ms: round(median(paintMoveShown)), paint_pick_round_trip_ms: round(median(paintTrips)),
     mouseup_to_gizmo_ms: round(mouseupToGizmo), set_region_ms: round(setRegion),
     mouseup_to_gizmo_beyond_set_region_ms: round(setRegion === null ? null : mouseupToGizmo - setRegion),
     drag_cycle_ms: round(median(hidden.ms)),

@@ -6,8 +6,8 @@
 // bundled bunny it also checks the editor's rules a new user meets (the manipulator only with the
 // Orbit tool and for a handle the server holds, a handle painted without support, k after a move,
 // the scale clamp, progress and busy buttons, export names, keys after a click, the brush keys,
-// the stats in view), the URL's display options, a cube drawn with sharp creases, and a broken
-// upload's message.
+// the stats in view), the URL's display options, a cube drawn with sharp creases, a large face's
+// colours near and far from a painted corner, and a broken upload's message.
 //
 //   node web/tests/e2e.mjs --cli build/bin/remora --web-root build/web --mesh data/bunny.ply \
 //        --screenshots build/
@@ -17,7 +17,7 @@
 import { join } from 'node:path';
 import { args, check, chromiumOrSkip, client, drag, ready, recordRequests, results, startServer, stroke,
          writeBumpyTorus } from './harness.mjs';
-import { brokenUpload, bugChecks, creases, displayOptions } from './e2e_rules.mjs';
+import { brokenUpload, bugChecks, creases, displayOptions, largeFaceColours } from './e2e_rules.mjs';
 
 const large = args.large ? Number(args.large) : 0;
 // Where to paint: the bunny's left ear, or the top of the torus (seen from +z).
@@ -155,6 +155,7 @@ try {
     await displayOptions(browser, url);
     await creases(page);
     await shot(page, 'editor-box.png');
+    await largeFaceColours(page);
     await brokenUpload(page, args.screenshots);
   }
 } catch (e) {

@@ -241,3 +241,52 @@ export async function creases(page) {
         `a cube is drawn with its creases split: ${drawn.drawn} vertices drawn for ${drawn.vertices}, ` +
         `normals off the sides' by ${drawn.worst}`);
 }
+
+/// On a part of large faces (a cube of two triangles per side) a painted corner colours its face
+/// only up to half-way: far from the corner the face keeps the unpainted colour, near it the
+/// colour changes. The pixels are compared before and after painting the one corner.
+export async function largeFaceColours(page) {
+  await page.setInputFiles('#file', { name: 'box1.obj', mimeType: 'text/plain', buffer: Buffer.from(boxObj(1)) });
+  await page.waitForFunction(() => window.remora.ready() && window.remora.meshName?.() === 'box1.obj', null, { timeout: 120000 })
+    .catch(() => {});
+  const setup = await page.evaluate(() => {
+    const p = window.remora.positionsHeld(), f = window.remora.indicesHeld(), eye = window.remora.camera();
+    const at = (v) => [p[3 * v], p[3 * v + 1], p[3 * v + 2]];
+    const v = window.remora.nearest(...eye);
+    let best = null;
+    for (let t = 0; t < f.length; t += 3) {
+      const c = [f[t], f[t + 1], f[t + 2]];
+      if (!c.includes(v)) continue;
+      const [a, b] = c.filter((x) => x !== v).map(at), o = at(v);
+      const mix = (wv, wa, wb) => [0, 1, 2].map((k) => wv * o[k] + wa * a[k] + wb * b[k]);
+      const screen = (q) => window.remora.projectPoint(...q);
+      const sa = screen(a), sb = screen(b), so = screen(o);
+      const area = Math.abs((sa.x - so.x) * (sb.y - so.y) - (sa.y - so.y) * (sb.x - so.x));
+      if (!best || area > best.area)
+        best = { area, start: screen(mix(0.97, 0.015, 0.015)), near: screen(mix(0.8, 0.1, 0.1)), far: screen(mix(0.25, 0.375, 0.375)) };
+    }
+    return { v, ...best };
+  });
+  const pixels = () => page.evaluate(async (points) => {
+    await new Promise((r) => requestAnimationFrame(() => requestAnimationFrame(r)));
+    const c = document.querySelector('#view canvas'), box = c.getBoundingClientRect(), s = c.width / box.width;
+    const t = document.createElement('canvas');
+    t.width = c.width; t.height = c.height;
+    const g = t.getContext('2d');
+    g.drawImage(c, 0, 0);
+    return points.map((q) => Array.from(g.getImageData(Math.round((q.x - box.left) * s), Math.round((q.y - box.top) * s), 1, 1).data));
+  }, [setup.near, setup.far]);
+  await page.keyboard.press('s');
+  await page.evaluate(() => window.remora.setRadius(0.3));
+  await page.mouse.move(setup.start.x, setup.start.y);
+  await page.waitForFunction(() => window.remora.shown().cursor, null, { timeout: 10000 }).catch(() => {});
+  const before = await pixels();
+  await drag(page, setup.start.x, setup.start.y, 0, 0, 2);
+  await ready(page);
+  const painted = await page.evaluate(() => window.remora.labels().filter((l) => l !== -2).length);
+  const after = await pixels();
+  const change = (i) => Math.max(...[0, 1, 2].map((k) => Math.abs(after[i][k] - before[i][k])));
+  check(painted === 1 && change(1) <= 2 && change(0) >= 20,
+        `a painted corner of a large face colours it only near the corner: ${painted} vertex painted, ` +
+        `pixel change near it ${change(0)}, far from it ${change(1)} (of 255)`);
+}

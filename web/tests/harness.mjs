@@ -71,11 +71,18 @@ export async function stroke(page, vertex, steps = 5) {
   await page.mouse.up();
 }
 
-/// Drags with the mouse from (x, y) by (dx, dy) per step, `steps` steps.
-export async function drag(page, x, y, dx, dy, steps = 10) {
+/// Drags with the mouse from (x, y) by (dx, dy) per step, `steps` steps; with `interval` (ms), a
+/// step starts no sooner than that after the one before (a hand's pace), else at once.
+export async function drag(page, x, y, dx, dy, steps = 10, interval = 0) {
   await page.mouse.move(x, y);
   await page.mouse.down();
-  for (let i = 1; i <= steps; ++i) await page.mouse.move(x + dx * i, y + dy * i);
+  let next = performance.now();
+  for (let i = 1; i <= steps; ++i) {
+    const wait = next - performance.now();
+    if (wait > 0) await new Promise((resolve) => setTimeout(resolve, wait));
+    next = performance.now() + interval;
+    await page.mouse.move(x + dx * i, y + dy * i);
+  }
   await page.mouse.up();
 }
 
