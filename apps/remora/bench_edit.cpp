@@ -4,6 +4,8 @@
 // decode, no solve) over a sequence of handle moves.
 #include <algorithm>
 #include <iostream>
+#include <map>
+#include <string>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -30,7 +32,8 @@ struct BenchEditArgs {
 
 struct BenchEditTimes {
   double load_ms = 0, preprocess_ms = 0, set_region_ms = 0;
-  std::vector<double> frames; ///< sorted
+  std::vector<double> frames;                ///< sorted
+  std::map<std::string, double> frame_parts; ///< medians of blend, normals, decode
 };
 
 /// A geodesic support around the vertex nearest the centroid, sized so that about `support`
@@ -47,8 +50,10 @@ void set_geodesic_region(Editor& editor, int support) {
   editor.set_region(order, {handle});
 }
 
-/// positions() after each of `count` handle moves (a lift and a turn), in milliseconds, sorted.
-std::vector<double> time_frames(Editor& editor, int count) {
+/// positions() after each of `count` handle moves (a lift and a turn), in milliseconds, sorted;
+/// the medians of the frame's parts (blend, normals, decode) go to `parts`.
+std::vector<double> time_frames(Editor& editor, int count, std::map<std::string, double>& parts) {
+  std::map<std::string, std::vector<double>> part_times;
   const double diagonal = bounding_box_diagonal(editor.input());
   const Eigen::Vector3d center = editor.handle_center(0);
   std::vector<double> frames;
@@ -60,8 +65,14 @@ std::vector<double> time_frames(Editor& editor, int count) {
     const Eigen::MatrixXd& p = editor.positions();
     frames.push_back(ms_since(t0));
     if (!p.allFinite()) throw NumericalError("bench edit: a frame has non-finite positions");
+    for (const char* part : {"blend", "normals", "decode"})
+      part_times[part].push_back(editor.report().milliseconds.at(std::string("frame ") + part));
   }
   std::sort(frames.begin(), frames.end());
+  for (auto& [part, times] : part_times) {
+    std::sort(times.begin(), times.end());
+    parts[part] = times[times.size() / 2];
+  }
   return frames;
 }
 
@@ -75,6 +86,7 @@ void print_bench_edit(const BenchEditArgs& a, const EditReport& r, const BenchEd
                   {"set_region_ms", t.set_region_ms},
                   {"frame_ms_median", median},
                   {"frame_ms_max", t.frames.back()},
+                  {"frame_parts_ms_median", t.frame_parts},
                   {"frames", t.frames.size()}};
     std::cout << j.dump(2) << "\n";
     return;
@@ -93,8 +105,9 @@ void print_bench_edit(const BenchEditArgs& a, const EditReport& r, const BenchEd
       r.milliseconds.at("assemble"), r.milliseconds.at("factor"), r.milliseconds.at("solve"),
       r.milliseconds.at("encode"), grouped(r.phong.encoded), r.solver);
   std::cout << fmt::format("frame (blend + decode): median {:.2f} ms, max {:.2f} ms over {} "
-                           "frames\n",
-                           median, t.frames.back(), t.frames.size());
+                           "frames (medians: blend {:.2f}, normals {:.2f}, decode {:.2f})\n",
+                           median, t.frames.back(), t.frames.size(), t.frame_parts.at("blend"),
+                           t.frame_parts.at("normals"), t.frame_parts.at("decode"));
 }
 
 void run_bench_edit(const BenchEditArgs& a) {
@@ -117,7 +130,7 @@ void run_bench_edit(const BenchEditArgs& a) {
   t0 = Clock::now();
   set_geodesic_region(editor, a.support);
   t.set_region_ms = ms_since(t0);
-  t.frames = time_frames(editor, a.frames);
+  t.frames = time_frames(editor, a.frames, t.frame_parts);
   print_bench_edit(a, editor.report(), t);
 }
 

@@ -15,6 +15,7 @@
 #include "remora/common/timer.h"
 #include "remora/geometry/laplacian.h"
 #include "remora/geometry/measures.h"
+#include "remora/multires/frame.h"
 #include "remora/multires/multigrid.h"
 
 namespace remora {
@@ -55,7 +56,7 @@ struct RegionState {
   std::vector<int> base_label;  // per B vertex
   int handles = 0;
   std::vector<int> free_vertices; // B vertices, in the row order of `basis`
-  Eigen::MatrixXd basis;          // n_free × (3 + 4h)
+  BasisRows basis;                // n_free × (3 + 4h)
   std::vector<std::vector<int>> handle_base;
   std::vector<Eigen::Vector3d> handle_centers;
   Eigen::MatrixXd rest;         // B0
@@ -63,9 +64,10 @@ struct RegionState {
   std::vector<int> encoded;     // O vertices, in the order of `details`
   std::vector<PhongDetail> details;
   std::vector<Eigen::Vector3d> rest_offsets; // DetailMode::Displacement: p − b on B0
-  std::vector<int> affected;                 // B vertices whose normal can change
+  NormalPlan affected;                       // B vertices whose normal can change, and their faces
   std::vector<Transform> transforms;
   Eigen::MatrixXd current_base, current_normals, current_positions;
+  std::vector<double> face_normals; // update_normals()'s scratch
   bool dirty = true;
 };
 
@@ -449,8 +451,10 @@ void Editor::Impl::find_affected(RegionState& r) const {
         r.base_label[static_cast<std::size_t>(f[1])] != Region::kFixed ||
         r.base_label[static_cast<std::size_t>(f[2])] != Region::kFixed)
       for (const int v : f) affected[static_cast<std::size_t>(v)] = 1;
+  std::vector<int> vertices;
   for (std::size_t v = 0; v < affected.size(); ++v)
-    if (affected[v]) r.affected.push_back(static_cast<int>(v));
+    if (affected[v]) vertices.push_back(static_cast<int>(v));
+  r.affected = plan_normals(topology, vertices);
 }
 
 void Editor::set_region(const std::vector<int>& support,
@@ -537,34 +541,20 @@ void Editor::Impl::update() {
   coefficients.topRows<3>().setIdentity();
   for (int j = 0; j < r.handles; ++j)
     coefficients.block<4, 3>(3 + 4 * j, 0) = r.transforms[static_cast<std::size_t>(j)].transpose();
-  const Eigen::MatrixXd moved = r.basis * coefficients;
   const int threads = options.threads;
-  parallel_for(r.free_vertices.size(), threads, [&](std::size_t row) {
-    r.current_base.row(r.free_vertices[row]) = moved.row(static_cast<Eigen::Index>(row));
-  });
+  blend_basis(r.basis, coefficients, r.free_vertices, r.current_base, threads);
   for (int j = 0; j < r.handles; ++j) {
     const Transform& t = r.transforms[static_cast<std::size_t>(j)];
     for (const int v : r.handle_base[static_cast<std::size_t>(j)])
       r.current_base.row(v) =
           (t.leftCols<3>() * base_rest.row(v).transpose() + t.col(3)).transpose();
   }
+  const auto t_normals = Clock::now();
+  report.milliseconds["frame blend"] = ms_since(t0);
   // Normals where they can change.
-  parallel_for(r.affected.size(), threads, [&](std::size_t a) {
-    const auto v = static_cast<std::size_t>(r.affected[a]);
-    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-    for (int k = topology.vertex_offsets[v]; k < topology.vertex_offsets[v + 1]; ++k) {
-      const auto& f =
-          topology
-              .faces[static_cast<std::size_t>(topology.vertex_faces[static_cast<std::size_t>(k)])];
-      const Eigen::Vector3d p0 = r.current_base.row(f[0]);
-      const Eigen::Vector3d p1 = r.current_base.row(f[1]);
-      const Eigen::Vector3d p2 = r.current_base.row(f[2]);
-      sum += (p1 - p0).cross(p2 - p0);
-    }
-    const double len = sum.norm();
-    r.current_normals.row(static_cast<Eigen::Index>(v)) =
-        len > 0.0 ? Eigen::RowVector3d((sum / len).transpose()) : Eigen::RowVector3d::Zero();
-  });
+  update_normals(topology, r.current_base, r.affected, r.current_normals, r.face_normals, threads);
+  const auto t_decode = Clock::now();
+  report.milliseconds["frame normals"] = ms_since(t_normals);
   // Decode.
   parallel_for(r.encoded.size(), threads, [&](std::size_t e) {
     const PhongDetail& d = r.details[e];
@@ -586,6 +576,7 @@ void Editor::Impl::update() {
     r.current_positions.row(r.encoded[e]) = p.transpose();
   });
   r.dirty = false;
+  report.milliseconds["frame decode"] = ms_since(t_decode);
   report.milliseconds["frame"] = ms_since(t0);
 }
 

@@ -1,0 +1,81 @@
+// One frame of the editor (multires/frame.h): the blend of the basis functions against the dense
+// product, and the normals of a region against vertex_normals() of the whole mesh, bit for bit.
+#include <algorithm>
+#include <random>
+#include <set>
+
+#include <gtest/gtest.h>
+
+#include "remora/mesh/primitives.h"
+#include "remora/multires/frame.h"
+
+namespace remora {
+namespace {
+
+TEST(Frame, BlendIsTheProductOfTheBasisAndTheCoefficientsOnTheFreeRows) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  const int n = 5000, free = 3000, m = 3 + 4 * 2; // two handles
+  BasisRows basis(free, m);
+  for (Eigen::Index i = 0; i < basis.size(); ++i) basis.data()[i] = u(rng);
+  Eigen::MatrixXd coefficients(m, 3);
+  for (Eigen::Index i = 0; i < coefficients.size(); ++i) coefficients.data()[i] = u(rng);
+  std::vector<int> rows(n);
+  for (int v = 0; v < n; ++v) rows[static_cast<std::size_t>(v)] = v;
+  std::shuffle(rows.begin(), rows.end(), rng);
+  rows.resize(free);
+  Eigen::MatrixXd positions = Eigen::MatrixXd::Constant(n, 3, 42.0);
+  blend_basis(basis, coefficients, rows, positions, 2);
+  const Eigen::MatrixXd expected = Eigen::MatrixXd(basis) * coefficients;
+  std::vector<char> written(n, 0);
+  for (int i = 0; i < free; ++i) {
+    const int v = rows[static_cast<std::size_t>(i)];
+    written[static_cast<std::size_t>(v)] = 1;
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(positions(v, c), expected(i, c), 1e-13) << v;
+  }
+  for (int v = 0; v < n; ++v)
+    if (!written[static_cast<std::size_t>(v)]) {
+      EXPECT_EQ(positions.row(v), Eigen::RowVector3d::Constant(42.0));
+    }
+}
+
+TEST(Frame, RegionNormalsAreTheWholeMeshsBitForBitAndNothingElseIsWritten) {
+  const Mesh mesh = make_icosphere(4, 1.0);
+  const TriangleTopology topology = triangle_topology(mesh);
+  std::mt19937 rng(3);
+  std::normal_distribution<double> noise(0.0, 0.02);
+  Eigen::MatrixXd positions(mesh.n_vertices(), 3);
+  for (const VertexHandle v : mesh.vertices())
+    for (int c = 0; c < 3; ++c) positions(v.idx(), c) = mesh.point(v)[c] + noise(rng);
+  // A cap: the vertices above z = 0.5.
+  std::vector<int> cap;
+  for (const VertexHandle v : mesh.vertices())
+    if (positions(v.idx(), 2) > 0.5) cap.push_back(v.idx());
+  ASSERT_GT(cap.size(), 100u);
+  const NormalPlan plan = plan_normals(topology, cap);
+  // Every face around the cap, each once.
+  std::set<int> around;
+  for (const int v : cap)
+    for (int k = topology.vertex_offsets[static_cast<std::size_t>(v)];
+         k < topology.vertex_offsets[static_cast<std::size_t>(v) + 1]; ++k)
+      around.insert(topology.vertex_faces[static_cast<std::size_t>(k)]);
+  EXPECT_EQ(std::set<int>(plan.faces.begin(), plan.faces.end()), around);
+  EXPECT_EQ(plan.faces.size(), around.size());
+
+  Eigen::MatrixXd normals = Eigen::MatrixXd::Constant(positions.rows(), 3, 7.0);
+  std::vector<double> scratch;
+  update_normals(topology, positions, plan, normals, scratch, 2);
+  const Eigen::MatrixXd all = vertex_normals(topology, positions);
+  std::vector<char> in_cap(positions.rows(), 0);
+  for (const int v : cap) {
+    in_cap[static_cast<std::size_t>(v)] = 1;
+    EXPECT_EQ(normals.row(v), all.row(v)) << v;
+  }
+  for (Eigen::Index v = 0; v < positions.rows(); ++v)
+    if (!in_cap[static_cast<std::size_t>(v)]) {
+      EXPECT_EQ(normals.row(v), Eigen::RowVector3d::Constant(7.0));
+    }
+}
+
+} // namespace
+} // namespace remora
