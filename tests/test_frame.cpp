@@ -1,5 +1,6 @@
 // One frame of the editor (multires/frame.h): the blend of the basis functions against the dense
-// product, and the normals of a region against vertex_normals() of the whole mesh, bit for bit.
+// product, and the normals of a region against vertex_normals() of the whole mesh, bit for bit;
+// a decode on row-major points equals the one on column-major points.
 #include <algorithm>
 #include <random>
 #include <set>
@@ -24,7 +25,7 @@ TEST(Frame, BlendIsTheProductOfTheBasisAndTheCoefficientsOnTheFreeRows) {
   for (int v = 0; v < n; ++v) rows[static_cast<std::size_t>(v)] = v;
   std::shuffle(rows.begin(), rows.end(), rng);
   rows.resize(free);
-  Eigen::MatrixXd positions = Eigen::MatrixXd::Constant(n, 3, 42.0);
+  RowPoints positions = RowPoints::Constant(n, 3, 42.0);
   blend_basis(basis, coefficients, rows, positions, 2);
   const Eigen::MatrixXd expected = Eigen::MatrixXd(basis) * coefficients;
   std::vector<char> written(n, 0);
@@ -35,7 +36,7 @@ TEST(Frame, BlendIsTheProductOfTheBasisAndTheCoefficientsOnTheFreeRows) {
   }
   for (int v = 0; v < n; ++v)
     if (!written[static_cast<std::size_t>(v)]) {
-      EXPECT_EQ(positions.row(v), Eigen::RowVector3d::Constant(42.0));
+      EXPECT_EQ(Eigen::RowVector3d(positions.row(v)), Eigen::RowVector3d::Constant(42.0));
     }
 }
 
@@ -44,7 +45,7 @@ TEST(Frame, RegionNormalsAreTheWholeMeshsBitForBitAndNothingElseIsWritten) {
   const TriangleTopology topology = triangle_topology(mesh);
   std::mt19937 rng(3);
   std::normal_distribution<double> noise(0.0, 0.02);
-  Eigen::MatrixXd positions(mesh.n_vertices(), 3);
+  RowPoints positions(mesh.n_vertices(), 3);
   for (const VertexHandle v : mesh.vertices())
     for (int c = 0; c < 3; ++c) positions(v.idx(), c) = mesh.point(v)[c] + noise(rng);
   // A cap: the vertices above z = 0.5.
@@ -62,19 +63,38 @@ TEST(Frame, RegionNormalsAreTheWholeMeshsBitForBitAndNothingElseIsWritten) {
   EXPECT_EQ(std::set<int>(plan.faces.begin(), plan.faces.end()), around);
   EXPECT_EQ(plan.faces.size(), around.size());
 
-  Eigen::MatrixXd normals = Eigen::MatrixXd::Constant(positions.rows(), 3, 7.0);
+  RowPoints normals = RowPoints::Constant(positions.rows(), 3, 7.0);
   std::vector<double> scratch;
   update_normals(topology, positions, plan, normals, scratch, 2);
-  const Eigen::MatrixXd all = vertex_normals(topology, positions);
+  const Eigen::MatrixXd all = vertex_normals(topology, Eigen::MatrixXd(positions));
   std::vector<char> in_cap(positions.rows(), 0);
   for (const int v : cap) {
     in_cap[static_cast<std::size_t>(v)] = 1;
-    EXPECT_EQ(normals.row(v), all.row(v)) << v;
+    EXPECT_EQ(Eigen::RowVector3d(normals.row(v)), Eigen::RowVector3d(all.row(v))) << v;
   }
   for (Eigen::Index v = 0; v < positions.rows(); ++v)
     if (!in_cap[static_cast<std::size_t>(v)]) {
-      EXPECT_EQ(normals.row(v), Eigen::RowVector3d::Constant(7.0));
+      EXPECT_EQ(Eigen::RowVector3d(normals.row(v)), Eigen::RowVector3d::Constant(7.0));
     }
+}
+
+TEST(Frame, DecodeOnRowMajorPointsIsTheSame) {
+  const Mesh mesh = make_icosphere(3, 1.0);
+  const TriangleTopology topology = triangle_topology(mesh);
+  Eigen::MatrixXd positions(mesh.n_vertices(), 3);
+  for (const VertexHandle v : mesh.vertices())
+    for (int c = 0; c < 3; ++c) positions(v.idx(), c) = mesh.point(v)[c];
+  const Eigen::MatrixXd normals = vertex_normals(topology, positions);
+  // Points off the sphere, each started at face 0.
+  Eigen::MatrixXd points = 1.05 * positions.topRows(40);
+  const std::vector<int> starts(40, 0);
+  const auto details = encode_phong(topology, positions, normals, points, starts);
+  const RowPoints row_positions = positions, row_normals = normals;
+  for (std::size_t i = 0; i < details.size(); ++i) {
+    const Eigen::Vector3d a = decode_phong(topology, positions, normals, details[i]);
+    EXPECT_EQ(a, decode_phong(topology, row_positions, row_normals, details[i])) << i;
+    EXPECT_LT((a - points.row(static_cast<Eigen::Index>(i)).transpose()).norm(), 1e-9) << i;
+  }
 }
 
 } // namespace

@@ -66,7 +66,8 @@ struct RegionState {
   std::vector<Eigen::Vector3d> rest_offsets; // DetailMode::Displacement: p − b on B0
   NormalPlan affected;                       // B vertices whose normal can change, and their faces
   std::vector<Transform> transforms;
-  Eigen::MatrixXd current_base, current_normals, current_positions;
+  RowPoints current_base, current_normals; // a vertex's x, y, z together: the frame's reads
+  Eigen::MatrixXd current_positions;
   std::vector<double> face_normals; // update_normals()'s scratch
   bool dirty = true;
 };
@@ -600,7 +601,7 @@ const Mesh& Editor::base() const {
   return impl_->base;
 }
 
-const Eigen::MatrixXd& Editor::base_positions() {
+Eigen::MatrixXd Editor::base_positions() {
   impl_->update();
   return impl_->region->current_base;
 }

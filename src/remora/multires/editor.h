@@ -159,8 +159,8 @@ public:
   const Mesh& input() const;
   /// The base B (the remeshed base surface, or S itself without remeshing) at rest.
   const Mesh& base() const;
-  /// B's vertex positions under the current transforms (B0 where nothing moved).
-  const Eigen::MatrixXd& base_positions();
+  /// B's vertex positions under the current transforms (B0 where nothing moved), a copy.
+  Eigen::MatrixXd base_positions();
   /// Applies the editor's low-pass filter (the one that made S) to per-vertex values of O.
   Eigen::MatrixXd low_pass(const Eigen::MatrixXd& values);
   /// Whether vertex i of O is in the current support (handles included).

@@ -11,7 +11,7 @@
 namespace remora {
 
 void blend_basis(const BasisRows& basis, const Eigen::MatrixXd& coefficients,
-                 const std::vector<int>& free_vertices, Eigen::MatrixXd& positions, int threads) {
+                 const std::vector<int>& free_vertices, RowPoints& positions, int threads) {
   assert(basis.rows() == static_cast<Eigen::Index>(free_vertices.size()));
   assert(basis.cols() == coefficients.rows() && coefficients.cols() == 3);
   const Eigen::Index m = basis.cols();
@@ -52,8 +52,8 @@ NormalPlan plan_normals(const TriangleTopology& topology, const std::vector<int>
   return plan;
 }
 
-void update_normals(const TriangleTopology& topology, const Eigen::MatrixXd& positions,
-                    const NormalPlan& plan, Eigen::MatrixXd& normals, std::vector<double>& scratch,
+void update_normals(const TriangleTopology& topology, const RowPoints& positions,
+                    const NormalPlan& plan, RowPoints& normals, std::vector<double>& scratch,
                     int threads) {
   scratch.resize(3 * plan.faces.size());
   parallel_for(plan.faces.size(), threads, [&](std::size_t i) {

@@ -20,7 +20,7 @@ using BasisRows = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::R
 /// X_free = Φ C of editor.h. coefficients: (3 + 4h) × 3. Parallel over the rows with `threads`
 /// threads (0 = all). Sizes are the caller's contract (checked in debug builds only).
 void blend_basis(const BasisRows& basis, const Eigen::MatrixXd& coefficients,
-                 const std::vector<int>& free_vertices, Eigen::MatrixXd& positions, int threads);
+                 const std::vector<int>& free_vertices, RowPoints& positions, int threads);
 
 /// What a frame's normals need, built once per region: `vertices`, whose normals can change;
 /// `faces`, every face around one of them; `ring`, for vertices[i] the positions in `faces` of its
@@ -35,8 +35,8 @@ NormalPlan plan_normals(const TriangleTopology& topology, const std::vector<int>
 /// normals.row(v) for every v of plan.vertices, as vertex_normals() computes them (the same sums
 /// in the same order, so bit for bit the same): the normalized sum of the faces' cross products,
 /// (0, 0, 0) where it vanishes. `scratch` holds the faces' cross products between calls.
-void update_normals(const TriangleTopology& topology, const Eigen::MatrixXd& positions,
-                    const NormalPlan& plan, Eigen::MatrixXd& normals, std::vector<double>& scratch,
+void update_normals(const TriangleTopology& topology, const RowPoints& positions,
+                    const NormalPlan& plan, RowPoints& normals, std::vector<double>& scratch,
                     int threads);
 
 } // namespace remora

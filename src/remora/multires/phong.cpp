@@ -23,8 +23,8 @@ struct Corners {
   V3 n[3];
 };
 
-Corners corners(const TriangleTopology& t, const Eigen::MatrixXd& positions,
-                const Eigen::MatrixXd& normals, int f) {
+template <class Points>
+Corners corners(const TriangleTopology& t, const Points& positions, const Points& normals, int f) {
   Corners c;
   for (int k = 0; k < 3; ++k) {
     const int v = t.faces[static_cast<std::size_t>(f)][static_cast<std::size_t>(k)];
@@ -321,6 +321,11 @@ std::vector<PhongDetail> encode_phong(const TriangleTopology& topology,
 
 Eigen::Vector3d decode_phong(const TriangleTopology& topology, const Eigen::MatrixXd& positions,
                              const Eigen::MatrixXd& normals, const PhongDetail& detail) {
+  return decode(corners(topology, positions, normals, detail.base.face.idx()), detail);
+}
+
+Eigen::Vector3d decode_phong(const TriangleTopology& topology, const RowPoints& positions,
+                             const RowPoints& normals, const PhongDetail& detail) {
   return decode(corners(topology, positions, normals, detail.base.face.idx()), detail);
 }
 

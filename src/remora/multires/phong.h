@@ -28,6 +28,9 @@
 namespace remora {
 
 /// A triangle mesh as plain arrays, for the tight loops of encoding and decoding.
+/// n × 3 points or vectors stored a vertex's row at a time: x, y, z together in memory.
+using RowPoints = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
+
 struct TriangleTopology {
   std::vector<std::array<int, 3>> faces;  ///< by face idx(), in face_vertices() order
   std::vector<std::array<int, 3>> across; ///< face across the edge opposite corner k, or -1
@@ -76,5 +79,8 @@ std::vector<PhongDetail> encode_phong(const TriangleTopology& topology,
 /// The point a detail stands for on the base (positions, normals).
 Eigen::Vector3d decode_phong(const TriangleTopology& topology, const Eigen::MatrixXd& positions,
                              const Eigen::MatrixXd& normals, const PhongDetail& detail);
+/// The same on positions and normals stored a vertex's row at a time (the editor's frame).
+Eigen::Vector3d decode_phong(const TriangleTopology& topology, const RowPoints& positions,
+                             const RowPoints& normals, const PhongDetail& detail);
 
 } // namespace remora
