@@ -2,6 +2,7 @@
 // the vertex is drawn once per group of faces, so that its normals do not smooth across the
 // crease (a CAD part's edges stay sharp instead of showing dark streaks). The mesh itself, its
 // ids and everything sent to the server are unchanged: the display keeps a map back to them.
+import { vertexFaces } from './normals.js';
 
 /// Splits the corners of `indices` (Uint32 triples over positions' vertices) at creases sharper
 /// than `angle` degrees. Returns null when nothing is split, otherwise { indices: the display's
@@ -9,13 +10,9 @@
 /// order), copies: { start, ids }, for mesh vertex v the extra display vertices
 /// ids[start[v]..start[v+1]) }. A face of zero area joins a vertex's first group.
 export function splitCreases(positions, indices, angle = 60) {
-  const n = positions.length / 3, m = indices.length / 3;
+  const n = positions.length / 3;
   const normals = faceNormals(positions, indices);
-  const start = new Uint32Array(n + 1);
-  for (let i = 0; i < indices.length; ++i) start[indices[i] + 1] += 1;
-  for (let v = 0; v < n; ++v) start[v + 1] += start[v];
-  const fill = start.slice(0, n), facesOf = new Uint32Array(indices.length);
-  for (let f = 0; f < m; ++f) for (let k = 0; k < 3; ++k) facesOf[fill[indices[3 * f + k]]++] = f;
+  const { begin: start, faces: facesOf } = vertexFaces(indices, n); // face offsets 3 f
 
   const cosLimit = Math.cos(angle * Math.PI / 180);
   const corners = Uint32Array.from(indices);
@@ -24,7 +21,7 @@ export function splitCreases(positions, indices, angle = 60) {
   for (let v = 0; v < n; ++v) {
     groups.length = 0;
     for (let i = start[v]; i < start[v + 1]; ++i) {
-      const f = facesOf[i];
+      const f = facesOf[i] / 3;
       let id = -1;
       for (const [g, gid] of groups) {
         const d = normals[3 * f] * normals[3 * g] + normals[3 * f + 1] * normals[3 * g + 1] + normals[3 * f + 2] * normals[3 * g + 2];

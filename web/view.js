@@ -141,9 +141,6 @@ export function setMesh(positions, indices) {
   scene.add(shown.edges);
   plan = null;
   around = vertexFaces(geometry.getIndex().array, n);
-  // A first plan, thrown away, so that the JIT has compiled normalPlan() before the first region
-  // (the first call runs two to three times slower).
-  normalPlan(geometry.getIndex().array, around, new Uint32Array(Math.min(n, 20000)).map((_, i) => i));
   redraw();
 }
 

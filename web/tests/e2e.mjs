@@ -112,6 +112,15 @@ async function core(page, log) {
     if (!inSupport.has(v))
       for (let c = 0; c < 3; ++c) if (after[3 * v + c] !== before[3 * v + c]) { outsideMoved += 1; break; }
   check(outsideMoved === 0, `no vertex outside the support moved (${outsideMoved} did)`);
+  // The page placed the drag's answers on the vertices the server moved (it takes the support it
+  // sent as the movable vertices, without asking).
+  const pageOff = await page.evaluate((server) => {
+    const held = window.remora.positionsHeld?.() ?? [];
+    let worst = held.length === server.length ? 0 : Infinity;
+    for (let i = 0; i < held.length && worst < Infinity; ++i) worst = Math.max(worst, Math.abs(held[i] - server[i]));
+    return worst;
+  }, Array.from(after));
+  check(pageOff < 1e-6, `after the drag the page holds the server's positions (off by ${pageOff})`);
   const normalError = await page.evaluate(() => window.remora.normalError?.() ?? Infinity);
   check(normalError < 1e-5, `after the drag the page's normals equal a full computeVertexNormals() (off by ${normalError.toExponential(2)})`);
   await shot(page, large ? 'editor-large-dragged.png' : 'editor-dragged.png');
