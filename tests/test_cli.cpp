@@ -391,5 +391,38 @@ TEST_F(Cli, EditRefusesBadRequestsAndWritesNothing) {
   }
 }
 
+// The limits of docs/limits.md on the command line: a mesh over --max-triangles is refused before
+// the work, an edit with more handles than --max-handles too, and no output file is left.
+TEST_F(Cli, EditAndRemeshRefuseWhatIsOverTheirLimits) {
+  const fs::path in = dir_ / "sphere.ply", out = dir_ / "out.ply";
+  write_mesh(in.string(), make_icosphere(3, 1.0)); // 1,280 triangles
+  const std::string quick =
+      " --support-sphere 0,0,1,0.5 --handle-sphere 0,0,1,0.1 --translate 0,0,0.1";
+  CliRun r = run("edit " + in.string() + " -o " + out.string() + quick + " --max-triangles 1000");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("over the limit of 1000 triangles"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+  r = run("remesh " + in.string() + " -o " + out.string() + " --max-triangles 1000");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("over the limit of 1000 triangles"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out));
+  const fs::path edit = write_text(
+      "three.json", R"({"support": {"sphere": {"center": [0, 0, 1], "radius": 0.8}}, "handles": [
+        {"region": {"sphere": {"center": [0, 0, 1], "radius": 0.1}}},
+        {"region": {"sphere": {"center": [0.5, 0, 0.85], "radius": 0.1}}},
+        {"region": {"sphere": {"center": [-0.5, 0, 0.85], "radius": 0.1}}}]})");
+  r = run("edit " + in.string() + " -o " + out.string() + " --edit " + edit.string() +
+          " --max-handles 2");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("the edit has 3 handles; at most 2 are accepted"), std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(out));
+  r = run("edit " + in.string() + " -o " + out.string() + quick + " --max-triangles 1280");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  // The default is stated in the help, with how it was derived.
+  r = run("edit --help");
+  EXPECT_NE(r.out.find("this machine's"), std::string::npos) << r.out;
+}
+
 } // namespace
 } // namespace remora

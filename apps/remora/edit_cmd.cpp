@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
+#include "limit_options.h"
 #include "remora/common/error.h"
 #include "remora/common/timer.h"
 #include "remora/geometry/measures.h"
@@ -131,6 +132,8 @@ struct EditArgs {
   std::string solver, areas, details;
   double base_smoothing = -1, base_feature_cap = -1, length_factor = -1;
   bool no_remesh = false, report = false, json = false;
+  std::uint64_t max_triangles = 0;
+  int max_handles = kMaxHandles;
 };
 
 void add_edit_options(CLI::App* cmd, EditArgs& a) {
@@ -180,6 +183,8 @@ void add_edit_options(CLI::App* cmd, EditArgs& a) {
       ->check(CLI::NonNegativeNumber);
   cmd->add_flag("--report", a.report, "Print timings and quality figures");
   cmd->add_flag("--json", a.json, "Print the report as one JSON object");
+  add_max_triangles_option(cmd, a.max_triangles, 1);
+  add_max_handles_option(cmd, a.max_handles);
 }
 
 EditRequest read_edit_file(const std::string& path) {
@@ -243,6 +248,7 @@ EditorOptions editor_options(const EditRequest& request, const EditArgs& a) {
   if (a.length_factor > 0) options.remesh_options.length_factor = a.length_factor;
   if (a.no_remesh) options.remesh = false;
   options.threads = a.threads;
+  options.max_region_bytes = editor_memory_share(physical_memory_bytes(), 1);
   // The unsymmetric system needs a solver for it.
   if (options.system.areas == AreaWeights::Mixed && options.solver.name.empty())
     options.solver.name = "lu";
@@ -301,9 +307,15 @@ void report_edit(const EditArgs& a, Editor& editor, const Selection& s, double l
 void run_edit(const EditArgs& a) {
   format_from_path(a.out); // fail on an unknown extension before the long work
   EditRequest request = edit_request(a);
+  if (request.handles.size() > static_cast<std::size_t>(a.max_handles))
+    throw InvalidArgument(fmt::format("the edit has {} handles; at most {} are accepted "
+                                      "(--max-handles)",
+                                      request.handles.size(), a.max_handles));
   EditorOptions options = editor_options(request, a);
   const auto t0 = Clock::now();
-  const LoadResult loaded = read_mesh(a.in);
+  ReadLimits limits;
+  limits.max_triangles = a.max_triangles;
+  const LoadResult loaded = read_mesh(a.in, {}, limits);
   const double load_ms = ms_since(t0);
   // Regions first: a bad selection should fail before the preprocessing.
   const Selection s = select_regions(request, loaded, a.in);

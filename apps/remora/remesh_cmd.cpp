@@ -6,6 +6,7 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.h"
+#include "limit_options.h"
 #include "remora/linalg/kharmonic.h"
 #include "remora/mesh/io.h"
 #include "remora/multires/base_surface.h"
@@ -105,6 +106,7 @@ struct RemeshArgs {
   std::string method = "newton";
   std::string smoothing_target = "odt";
   bool no_project = false, report = false, json = false;
+  std::uint64_t max_triangles = 0;
 };
 
 // The cycles: target length and cycle counts.
@@ -214,7 +216,9 @@ void add_output_options(CLI::App* cmd, RemeshArgs& a) {
 
 void run_remesh(const RemeshArgs& a) {
   format_from_path(a.out); // fail on an unknown extension before the long work
-  LoadResult loaded = read_mesh(a.in);
+  ReadLimits limits;
+  limits.max_triangles = a.max_triangles;
+  LoadResult loaded = read_mesh(a.in, {}, limits);
   std::optional<LowPassStats> low_pass;
   if (a.low_pass > 0) {
     // The editor's base surface S (multires/base_surface.h): same connectivity, smooth points.
@@ -274,6 +278,7 @@ void add_remesh_command(CLI::App& app) {
   add_equalization_options(cmd, *a);
   add_boundary_options(cmd, *a);
   add_output_options(cmd, *a);
+  add_max_triangles_option(cmd, a->max_triangles, 1);
   cmd->callback([a] { run_remesh(*a); });
 }
 

@@ -11,6 +11,7 @@
 #include "api.h"
 #include "commands.h"
 #include "http.h"
+#include "limit_options.h"
 #include "remora/common/error.h"
 #include "session.h"
 
@@ -33,8 +34,9 @@ void add_serve_command(CLI::App& app) {
   auto* cmd = app.add_subcommand("serve", "The editor in the browser: serves the page and its API");
   struct Args {
     std::string mesh, host = "127.0.0.1", web_root = REMORA_WEB_ROOT;
-    int port = 8080, threads = 0;
+    int port = 8080, threads = 0, max_handles = kMaxHandles, history_editors = 3;
     double max_upload_mb = 256;
+    std::uint64_t max_triangles = 0;
   };
   auto a = std::make_shared<Args>();
   cmd->add_option("mesh", a->mesh, "Mesh to load at start (.obj .off .ply .stl)");
@@ -46,7 +48,17 @@ void add_serve_command(CLI::App& app) {
       ->check(CLI::PositiveNumber);
   cmd->add_option("--threads", a->threads, "Editor threads (default: all)")
       ->check(CLI::NonNegativeNumber);
-  cmd->callback([a] {
+  cmd->add_option("--history-editors", a->history_editors,
+                  "Editors (one per bake) the undo history keeps alive (default 3); fewer raise "
+                  "the default --max-triangles")
+      ->check(CLI::PositiveNumber);
+  // The history keeps its editors alive and a bake builds one more.
+  add_max_triangles_option(cmd, a->max_triangles, a->history_editors + 1);
+  add_max_handles_option(cmd, a->max_handles);
+  cmd->callback([a, cmd] {
+    // The default of --max-triangles for the --history-editors given.
+    if (cmd->count("--max-triangles") == 0)
+      a->max_triangles = editor_triangle_limit(physical_memory_bytes(), a->history_editors + 1);
     if (!std::filesystem::exists(std::filesystem::path(a->web_root) / "index.html"))
       throw InvalidArgument(fmt::format(
           "the page's files are not in {0} (index.html missing): build them with `make build` "
@@ -54,6 +66,11 @@ void add_serve_command(CLI::App& app) {
           a->web_root));
     server::SessionOptions options;
     options.threads = a->threads;
+    options.max_editors = static_cast<std::size_t>(a->history_editors);
+    options.editor.max_region_bytes =
+        editor_memory_share(physical_memory_bytes(), a->history_editors + 1);
+    options.read.max_triangles = a->max_triangles;
+    options.max_handles = a->max_handles;
     server::Session session(options);
     server::ApiLimits limits;
     limits.max_upload_bytes = static_cast<std::size_t>(a->max_upload_mb * 1024 * 1024);

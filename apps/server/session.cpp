@@ -159,13 +159,18 @@ struct Session::Impl {
       idle.notify_all();
     });
   }
+  /// report() under the lock, then the options' own progress callback without it. On the worker.
+  void progress(std::string_view p, int s, int n) {
+    {
+      std::lock_guard lock(mutex);
+      report(p, s, n);
+    }
+    if (options.editor.progress) options.editor.progress(p, s, n);
+  }
   EditorOptions editor_options() {
     EditorOptions o = options.editor;
     o.threads = options.threads;
-    o.progress = [this](std::string_view p, int s, int n) {
-      std::lock_guard lock(mutex);
-      report(p, s, n);
-    };
+    o.progress = [this](std::string_view p, int s, int n) { progress(p, s, n); };
     return o;
   }
 };
@@ -198,9 +203,9 @@ void Session::start_load(std::string bytes, std::string name) {
       std::lock_guard guard(m.mutex);
       m.span_begin = 0.0;
       m.span_end = 1.0;
-      m.report("reading", 0, 1);
     }
-    LoadResult loaded = read_mesh_from_memory(bytes, format, name);
+    m.progress("reading", 0, 1);
+    LoadResult loaded = read_mesh_from_memory(bytes, format, name, {}, m.options.read);
     auto shape = std::make_shared<Shape>(loaded.mesh);
     auto box = std::make_shared<EditorBox>(Editor(std::move(loaded.mesh), m.editor_options()));
     box->preprocess_ms = ms_since(t0);
@@ -223,7 +228,17 @@ void Session::start_region(std::vector<int> support, std::vector<std::vector<int
   Impl& m = *impl_;
   m.require_ready();
   if (k < 1 || k > 3) throw InvalidArgument(fmt::format("k = {} is not 1, 2 or 3", k));
+  if (handles.size() > static_cast<std::size_t>(m.options.max_handles))
+    throw InvalidArgument(fmt::format("{} handles: at most {} are accepted (remora serve "
+                                      "--max-handles)",
+                                      handles.size(), m.options.max_handles));
   const auto n = static_cast<int>(m.box->editor.input().n_vertices());
+  // Longer lists can only repeat ids: refused before any work sized by them.
+  const auto too_long = [n](std::size_t size) { return size > static_cast<std::size_t>(n); };
+  if (too_long(support.size()) || std::any_of(handles.begin(), handles.end(),
+                                              [&](const auto& h) { return too_long(h.size()); }))
+    throw InvalidArgument(
+        fmt::format("a region lists more ids than the mesh has vertices ({})", n));
   for (const int v : support)
     if (v < 0 || v >= n)
       throw InvalidArgument(fmt::format("support vertex {} is out of range (the mesh has {} "
@@ -254,10 +269,7 @@ void Session::start_region(std::vector<int> support, std::vector<std::vector<int
             box = std::make_shared<EditorBox>(Editor(std::move(result), s.editor_options()));
             box->preprocess_ms = ms_since(t0);
           }
-          {
-            std::lock_guard guard(s.mutex);
-            s.report("set_region", 0, 1);
-          }
+          s.progress("set_region", 0, 1);
           // On a copy of the key: a failure leaves the session as it was.
           box->editor.set_system({key.k, box->editor.options().system.areas});
           box->editor.set_region(key.support, key.handles);

@@ -25,7 +25,9 @@
 
 #include "remora/common/error.h"
 #include "remora/mesh/mesh.h"
+#include "remora/mesh/soup.h"
 #include "remora/multires/editor.h"
+#include "remora/multires/limits.h"
 #include "shape.h"
 
 namespace remora::server {
@@ -37,10 +39,15 @@ public:
 };
 
 struct SessionOptions {
-  int threads = 0;              ///< editor threads (0 = all)
-  std::size_t max_history = 64; ///< snapshots kept for undo
-  std::size_t max_editors = 3;  ///< distinct editors (one per bake) the history keeps alive
-  EditorOptions editor;         ///< defaults for every editor the session builds
+  int threads = 0;               ///< editor threads (0 = all)
+  ReadLimits read;               ///< what a load accepts (mesh/soup.h; 0 = no limit)
+  int max_handles = kMaxHandles; ///< handles a region may have (multires/limits.h)
+  std::size_t max_history = 64;  ///< snapshots kept for undo
+  std::size_t max_editors = 3;   ///< distinct editors (one per bake) the history keeps alive
+  /// Defaults for every editor the session builds. Its progress callback, if any, is called on
+  /// the worker at every phase of every job ("reading", the editor's phases, "set_region"),
+  /// after the session has recorded it, without the session's lock held.
+  EditorOptions editor;
 };
 
 class Session {
@@ -51,11 +58,13 @@ public:
   Session& operator=(const Session&) = delete;
 
   /// Starts loading (parse, repair, preprocess) on the worker. `bytes` are a file's content, `name`
-  /// its file name (the extension gives the format). Throws Busy while other work runs.
+  /// its file name (the extension gives the format). A file over options.read fails the job
+  /// before the memory for it is allocated. Throws Busy while other work runs.
   void start_load(std::string bytes, std::string name);
   /// Starts a new region on the worker (baking the current result first when a handle moved,
   /// except when only k changes: then the handles keep their transforms and the new system is
-  /// solved under them). Validates ids and k first (InvalidArgument). Throws Busy while other
+  /// solved under them). Validates first (InvalidArgument): k, ids in range, at most
+  /// max_handles handles, no list longer than the mesh has vertices. Throws Busy while other
   /// work runs.
   void start_region(std::vector<int> support, std::vector<std::vector<int>> handles, int k);
   /// Blocks until the worker is idle (tests and the CLI).

@@ -1,5 +1,7 @@
 #include "remora/common/memory.h"
 
+#include <unistd.h>
+
 #include <cstdlib> // defines __GLIBC__ under glibc
 
 #if defined(__GLIBC__)
@@ -7,6 +9,11 @@
 #endif
 
 namespace remora {
+
+std::uint64_t physical_memory_bytes() {
+  const long pages = sysconf(_SC_PHYS_PAGES), page = sysconf(_SC_PAGESIZE);
+  return pages > 0 && page > 0 ? std::uint64_t(pages) * std::uint64_t(page) : 0;
+}
 
 bool keep_freed_memory() {
 #if defined(__GLIBC__)

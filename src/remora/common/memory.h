@@ -1,7 +1,12 @@
 // Process-wide allocator settings for the apps (the library itself never calls this).
 #pragma once
 
+#include <cstdint>
+
 namespace remora {
+
+/// The machine's physical memory in bytes (sysconf), 0 where it cannot be told.
+std::uint64_t physical_memory_bytes();
 
 /// Asks the C library to serve large allocations from its heap instead of fresh mappings, and
 /// not to hand freed memory back to the system before exit. A remesh of a million triangles

@@ -214,6 +214,17 @@ void SkipCounter::report(std::vector<std::string>& out) const {
     out.push_back(std::to_string(count) + " '" + key + "' line" + plural(count));
 }
 
+void check_limit(std::uint64_t count, std::uint64_t limit, const std::string& what,
+                 const char* unit, const std::string& name, std::optional<std::uint64_t> line,
+                 std::optional<std::uint64_t> byte) {
+  if (limit == 0 || count <= limit) return;
+  throw IoError(name,
+                what + ": over the limit of " + std::to_string(limit) + " " + unit +
+                    " this program accepts (the memory the editor needs for it; raise it with "
+                    "--max-triangles)",
+                line, byte);
+}
+
 CompactMesh compact(const Mesh& mesh) {
   CompactMesh out;
   std::vector<std::uint32_t> id(mesh.n_vertices(), 0);
@@ -324,24 +335,42 @@ MeshFormat format_from_path(const std::string& path) {
                           "' (" + supported + ")");
 }
 
-SoupFile read_soup(const std::string& path) {
+SoupFile read_soup(const std::string& path, const ReadLimits& limits) {
   const MeshFormat format = format_from_path(path);
   const std::string bytes = read_file(path);
-  return read_soup_from_memory(bytes, format, path);
+  return read_soup_from_memory(bytes, format, path, limits);
 }
 
-SoupFile read_soup_from_memory(std::string_view bytes, MeshFormat format, const std::string& name) {
+namespace {
+
+SoupFile read_format(std::string_view bytes, MeshFormat format, const std::string& name,
+                     const ReadLimits& limits) {
   switch (format) {
   case MeshFormat::Obj:
-    return io_detail::read_obj(bytes, name);
+    return io_detail::read_obj(bytes, name, limits);
   case MeshFormat::Off:
-    return io_detail::read_off(bytes, name);
+    return io_detail::read_off(bytes, name, limits);
   case MeshFormat::Ply:
-    return io_detail::read_ply(bytes, name);
+    return io_detail::read_ply(bytes, name, limits);
   case MeshFormat::Stl:
-    return io_detail::read_stl(bytes, name);
+    return io_detail::read_stl(bytes, name, limits);
   }
   throw IoError(name, "unknown mesh format");
+}
+
+} // namespace
+
+SoupFile read_soup_from_memory(std::string_view bytes, MeshFormat format, const std::string& name,
+                               const ReadLimits& limits) {
+  SoupFile file = read_format(bytes, format, name, limits);
+  // The triangles polygons and strips make, before the repair allocates for them.
+  std::uint64_t triangles = 0;
+  for (std::size_t f = 0; f < file.soup.num_polygons(); ++f)
+    if (file.soup.polygon_size(f) > 2) triangles += file.soup.polygon_size(f) - 2;
+  io_detail::check_limit(triangles, limits.max_triangles,
+                         "the faces make " + std::to_string(triangles) + " triangles", "triangles",
+                         name);
+  return file;
 }
 
 std::string write_mesh_to_memory(const Mesh& mesh, MeshFormat format, const std::string& name,

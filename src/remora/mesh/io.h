@@ -28,11 +28,13 @@ enum class MeshFormat { Obj, Off, Ply, Stl };
 /// Throws IoError for any other extension.
 MeshFormat format_from_path(const std::string& path);
 
-/// Parses a file into a soup, exactly as stored (no welding, no dropping). Throws IoError.
-SoupFile read_soup(const std::string& path);
+/// Parses a file into a soup, exactly as stored (no welding, no dropping). Throws IoError, also
+/// for a file over `limits`.
+SoupFile read_soup(const std::string& path, const ReadLimits& limits = {});
 
 /// Parses bytes already in memory; `name` is used in error messages (e.g. an upload's file name).
-SoupFile read_soup_from_memory(std::string_view bytes, MeshFormat format, const std::string& name);
+SoupFile read_soup_from_memory(std::string_view bytes, MeshFormat format, const std::string& name,
+                               const ReadLimits& limits = {});
 
 /// A mesh read from a file and repaired, with the full account of what was changed.
 struct LoadResult {
@@ -42,11 +44,12 @@ struct LoadResult {
   std::vector<std::uint32_t> source_vertex;
 };
 
-/// read_soup() followed by repair_soup(). Throws IoError for a malformed file, and when nothing
-/// is left to load (an empty mesh).
-LoadResult read_mesh(const std::string& path, const RepairOptions& options = {});
+/// read_soup() followed by repair_soup(). Throws IoError for a malformed file, a file over
+/// `limits`, and when nothing is left to load (an empty mesh).
+LoadResult read_mesh(const std::string& path, const RepairOptions& options = {},
+                     const ReadLimits& limits = {});
 LoadResult read_mesh_from_memory(std::string_view bytes, MeshFormat format, const std::string& name,
-                                 const RepairOptions& options = {});
+                                 const RepairOptions& options = {}, const ReadLimits& limits = {});
 
 struct WriteOptions {
   bool binary = true; ///< PLY and STL: binary (default) or ascii. OBJ and OFF are always text.

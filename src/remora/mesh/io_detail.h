@@ -20,10 +20,17 @@
 namespace remora::io_detail {
 
 // Parsers: `bytes` is the whole file, `name` the path or name used in error messages.
-SoupFile read_obj(std::string_view bytes, const std::string& name);
-SoupFile read_off(std::string_view bytes, const std::string& name);
-SoupFile read_ply(std::string_view bytes, const std::string& name);
-SoupFile read_stl(std::string_view bytes, const std::string& name);
+// Each refuses what is over `limits` before allocating for it (soup.h).
+SoupFile read_obj(std::string_view bytes, const std::string& name, const ReadLimits& limits);
+SoupFile read_off(std::string_view bytes, const std::string& name, const ReadLimits& limits);
+SoupFile read_ply(std::string_view bytes, const std::string& name, const ReadLimits& limits);
+SoupFile read_stl(std::string_view bytes, const std::string& name, const ReadLimits& limits);
+
+/// Throws IoError "<count> <what>: over the limit of <limit> <unit> ..." when `limit` is not 0
+/// and `count` exceeds it; `line` or `byte` place it in the file.
+void check_limit(std::uint64_t count, std::uint64_t limit, const std::string& what,
+                 const char* unit, const std::string& name, std::optional<std::uint64_t> line = {},
+                 std::optional<std::uint64_t> byte = {});
 
 /// The non-deleted vertices and faces of a mesh with compact 0-based vertex ids.
 struct CompactMesh {

@@ -95,7 +95,7 @@ void check_forward(const std::vector<ForwardReference>& forward, std::int64_t co
 
 } // namespace
 
-SoupFile read_obj(std::string_view bytes, const std::string& name) {
+SoupFile read_obj(std::string_view bytes, const std::string& name, const ReadLimits& limits) {
   check_text(bytes, name);
   if (bytes.starts_with("\xEF\xBB\xBF")) bytes.remove_prefix(3); // UTF-8 byte-order mark
 
@@ -108,6 +108,7 @@ SoupFile read_obj(std::string_view bytes, const std::string& name) {
   std::vector<ForwardReference> forward;
   std::vector<std::uint32_t> corners;
   std::string joined;
+  std::uint64_t triangles = 0;
 
   LineReader lines(bytes);
   std::string_view raw;
@@ -121,9 +122,14 @@ SoupFile read_obj(std::string_view bytes, const std::string& name) {
     if (key == "v") {
       // `v x y z [w] [r g b]`: anything after z is read past.
       soup.points.push_back(parse_point(rest, soup.points.size() + 1, name, line_no));
+      check_limit(soup.points.size(), limits.max_vertices(), "more vertices", "vertices", name,
+                  line_no);
     } else if (key == "f") {
       read_face(rest, static_cast<std::int64_t>(soup.points.size()), name, line_no, corners,
                 forward);
+      triangles += corners.size() - 2;
+      check_limit(triangles, limits.max_triangles, "the faces make more triangles", "triangles",
+                  name, line_no);
       soup.add_polygon(corners.data(), corners.size());
     } else {
       skipped.add(key);

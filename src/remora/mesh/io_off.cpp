@@ -143,11 +143,17 @@ void read_face(std::string_view rest, std::uint64_t f, std::int64_t nv, const st
 
 } // namespace
 
-SoupFile read_off(std::string_view bytes, const std::string& name) {
+SoupFile read_off(std::string_view bytes, const std::string& name, const ReadLimits& limits) {
   check_text(bytes, name);
   if (bytes.starts_with("\xEF\xBB\xBF")) bytes.remove_prefix(3); // UTF-8 byte-order mark
   ContentLines lines(bytes, name);
   const Counts counts = read_header(lines, name);
+  check_limit(static_cast<std::uint64_t>(counts.vertices), limits.max_vertices(),
+              "the header declares " + std::to_string(counts.vertices) + " vertices", "vertices",
+              name, lines.line());
+  check_limit(static_cast<std::uint64_t>(counts.faces), limits.max_triangles,
+              "the header declares " + std::to_string(counts.faces) + " faces", "triangles", name,
+              lines.line());
 
   SoupFile result;
   result.info.format = "off";

@@ -355,7 +355,8 @@ std::string skipped_element(const PlyElement& e) {
 // The records of every element in header order: vertices and faces into result.soup, the other
 // elements read past and listed in result.info.skipped; fails at data after the last element.
 template <class Source>
-void read_body(Source& src, const PlyHeader& h, std::size_t file_size, SoupFile& result) {
+void read_body(Source& src, const PlyHeader& h, std::size_t file_size, const ReadLimits& limits,
+               const std::string& name, SoupFile& result) {
   PolygonSoup& soup = result.soup;
   std::uint64_t vertex_count = 0;
   for (std::size_t ei = 0; ei < h.elements.size(); ++ei) {
@@ -372,12 +373,19 @@ void read_body(Source& src, const PlyHeader& h, std::size_t file_size, SoupFile&
       result.info.skipped.push_back(skipped_element(e));
       break;
     case Kind::Vertex:
+      check_limit(e.count, limits.max_vertices(),
+                  "the header declares " + std::to_string(e.count) + " vertices", "vertices", name,
+                  e.line);
       vertex_count = e.count;
       read_vertices(src, e, ei, reserve, soup);
       result.info.vertices_in_file = soup.points.size();
       break;
     case Kind::Face:
     case Kind::Strips:
+      if (e.kind == Kind::Face)
+        check_limit(e.count, limits.max_triangles,
+                    "the header declares " + std::to_string(e.count) + " faces", "triangles", name,
+                    e.line);
       result.info.faces_in_file += read_faces(src, e, ei, vertex_count, reserve, soup);
       break;
     }
@@ -387,7 +395,7 @@ void read_body(Source& src, const PlyHeader& h, std::size_t file_size, SoupFile&
 
 } // namespace
 
-SoupFile read_ply(std::string_view bytes, const std::string& name) {
+SoupFile read_ply(std::string_view bytes, const std::string& name, const ReadLimits& limits) {
   PlyHeader h = parse_header(bytes, name);
   assign_roles(h, name);
 
@@ -398,10 +406,10 @@ SoupFile read_ply(std::string_view bytes, const std::string& name) {
     const std::string_view body = bytes.substr(h.data_offset);
     check_text(body, name, h.lines + 1, h.data_offset);
     AsciiSource src(body, h.lines, name, h.elements);
-    read_body(src, h, bytes.size(), result);
+    read_body(src, h, bytes.size(), limits, name, result);
   } else {
     BinarySource src(bytes, h.data_offset, h.big_endian, name, h.elements);
-    read_body(src, h, bytes.size(), result);
+    read_body(src, h, bytes.size(), limits, name, result);
   }
   if (result.soup.num_polygons() == 0)
     throw IoError(name, "no faces: the file declares " +

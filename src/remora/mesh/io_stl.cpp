@@ -19,7 +19,11 @@ bool iequals(std::string_view a, std::string_view b) {
   return true;
 }
 
-SoupFile read_binary_stl(std::string_view bytes, std::uint32_t count, const std::string& name) {
+SoupFile read_binary_stl(std::string_view bytes, std::uint32_t count, const std::string& name,
+                         const ReadLimits& limits) {
+  check_limit(count, limits.max_triangles,
+              "the binary STL header declares " + std::to_string(count) + " triangles", "triangles",
+              name, {}, 80);
   if (count == 0)
     throw IoError(name,
                   "no faces: the binary STL header declares 0 triangles (an empty mesh cannot be "
@@ -57,7 +61,8 @@ SoupFile read_binary_stl(std::string_view bytes, std::uint32_t count, const std:
 // Each facet's vertices are appended to the soup as a new polygon.
 class AsciiStlParser {
 public:
-  AsciiStlParser(const std::string& name, PolygonSoup& soup) : name_(name), soup_(soup) {}
+  AsciiStlParser(const std::string& name, PolygonSoup& soup, const ReadLimits& limits)
+      : name_(name), soup_(soup), limits_(limits) {}
 
   /// Takes line `line`, whose first token is `key` and the tokens after it `rest`; throws
   /// IoError where the grammar does not allow `key`.
@@ -136,6 +141,8 @@ private:
   void in_loop(std::string_view key, std::string_view rest, std::uint64_t line) {
     if (iequals(key, "vertex")) {
       soup_.points.push_back(parse_point(rest, soup_.points.size(), name_, line));
+      check_limit(soup_.points.size(), limits_.max_vertices(), "more vertices", "vertices", name_,
+                  line);
     } else if (iequals(key, "endloop")) {
       add_facet(line);
       state_ = State::LoopDone;
@@ -154,6 +161,9 @@ private:
     corners_.clear();
     for (std::size_t i = loop_start_; i < soup_.points.size(); ++i)
       corners_.push_back(static_cast<std::uint32_t>(i));
+    triangles_ += n - 2;
+    check_limit(triangles_, limits_.max_triangles, "the facets make more triangles", "triangles",
+                name_, line);
     soup_.add_polygon(corners_.data(), corners_.size());
   }
 
@@ -167,20 +177,22 @@ private:
 
   const std::string& name_;
   PolygonSoup& soup_;
+  const ReadLimits& limits_;
+  std::uint64_t triangles_ = 0; // made by the facets so far
   State state_ = State::Outside;
   std::size_t solids_ = 0;     // solids closed so far
   std::size_t loop_start_ = 0; // the first vertex of the open loop
   std::vector<std::uint32_t> corners_;
 };
 
-SoupFile read_ascii_stl(std::string_view bytes, const std::string& name) {
+SoupFile read_ascii_stl(std::string_view bytes, const std::string& name, const ReadLimits& limits) {
   check_text(bytes, name);
   if (bytes.starts_with("\xEF\xBB\xBF")) bytes.remove_prefix(3); // UTF-8 byte-order mark
   SoupFile result;
   result.info.format = "stl";
   result.info.encoding = "ascii";
   PolygonSoup& soup = result.soup;
-  AsciiStlParser parser(name, soup);
+  AsciiStlParser parser(name, soup, limits);
 
   LineReader lines(bytes);
   std::string_view raw;
@@ -228,18 +240,18 @@ void append_float3(std::string& out, const Vec3& p) {
 
 } // namespace
 
-SoupFile read_stl(std::string_view bytes, const std::string& name) {
+SoupFile read_stl(std::string_view bytes, const std::string& name, const ReadLimits& limits) {
   if (bytes.size() >= kHeaderBytes) {
     // The size test decides: binary files may begin with "solid" too.
     const auto count = load<std::uint32_t>(bytes.data() + 80, false);
     if (bytes.size() == kHeaderBytes + kFacetBytes * std::uint64_t{count})
-      return read_binary_stl(bytes, count, name);
+      return read_binary_stl(bytes, count, name, limits);
   }
   std::size_t i = 0;
   if (bytes.starts_with("\xEF\xBB\xBF")) i = 3; // UTF-8 byte-order mark
   while (i < bytes.size() && (is_blank(bytes[i]) || bytes[i] == '\n')) ++i;
   const bool solid = bytes.size() - i >= 5 && iequals(bytes.substr(i, 5), "solid");
-  if (solid && looks_like_ascii(bytes, i)) return read_ascii_stl(bytes, name);
+  if (solid && looks_like_ascii(bytes, i)) return read_ascii_stl(bytes, name, limits);
   if (bytes.empty()) throw IoError(name, "no faces: the file is empty");
   if (bytes.size() < kHeaderBytes)
     throw IoError(name, "not an STL file: " + std::to_string(bytes.size()) +

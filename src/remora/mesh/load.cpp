@@ -24,13 +24,14 @@ LoadResult repair_file(SoupFile file, const std::string& name, const RepairOptio
 
 } // namespace
 
-LoadResult read_mesh(const std::string& path, const RepairOptions& options) {
-  return repair_file(read_soup(path), path, options);
+LoadResult read_mesh(const std::string& path, const RepairOptions& options,
+                     const ReadLimits& limits) {
+  return repair_file(read_soup(path, limits), path, options);
 }
 
 LoadResult read_mesh_from_memory(std::string_view bytes, MeshFormat format, const std::string& name,
-                                 const RepairOptions& options) {
-  return repair_file(read_soup_from_memory(bytes, format, name), name, options);
+                                 const RepairOptions& options, const ReadLimits& limits) {
+  return repair_file(read_soup_from_memory(bytes, format, name, limits), name, options);
 }
 
 } // namespace remora

@@ -40,6 +40,16 @@ struct FileInfo {
       skipped; ///< what was read past on purpose, e.g. "element camera (1)", "12 'vt' lines"
 };
 
+/// What a reader accepts (0 = no limit). A file over a limit is refused with an IoError before
+/// the memory for it is allocated: counts a header declares (PLY, OFF, binary STL) are checked as
+/// the header is read, the records of files without such counts (OBJ, ascii STL) as they are
+/// read, and the triangles polygons and strips make once the file is read, before the repair.
+struct ReadLimits {
+  std::uint64_t max_triangles = 0; ///< triangles (a polygon of n corners makes n - 2)
+  /// Vertex records: 3 per triangle, what an STL of max_triangles holds.
+  std::uint64_t max_vertices() const { return 3 * max_triangles; }
+};
+
 /// A soup read from a file together with what the reader saw.
 struct SoupFile {
   PolygonSoup soup;

@@ -83,9 +83,11 @@ std::string name(const json& j, const std::string& path,
   return s;
 }
 
-} // namespace
+/// Unions nest at most this deep: the parse and the selection recurse once per level, and a
+/// file of nested unions must not overflow the stack.
+constexpr int kMaxUnionDepth = 32;
 
-RegionSpec parse_region(const json& j, const std::string& path) {
+RegionSpec parse_region_at(const json& j, const std::string& path, int depth) {
   RegionSpec r;
   if (j.is_array()) {
     r.kind = RegionSpec::Kind::Vertices;
@@ -121,10 +123,18 @@ RegionSpec parse_region(const json& j, const std::string& path) {
   } else {
     r.kind = RegionSpec::Kind::Union;
     if (!value.is_array() || value.empty()) fail(sub, "expected a non-empty array of regions");
+    if (depth >= kMaxUnionDepth)
+      fail(sub, fmt::format("unions nested more than {} deep", kMaxUnionDepth));
     for (std::size_t i = 0; i < value.size(); ++i)
-      r.parts.push_back(parse_region(value[i], fmt::format("{}[{}]", sub, i)));
+      r.parts.push_back(parse_region_at(value[i], fmt::format("{}[{}]", sub, i), depth + 1));
   }
   return r;
+}
+
+} // namespace
+
+RegionSpec parse_region(const json& j, const std::string& path) {
+  return parse_region_at(j, path, 0);
 }
 
 TransformSpec parse_transform(const json& j, const std::string& path) {

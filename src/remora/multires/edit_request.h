@@ -64,8 +64,8 @@ struct EditRequest {
   std::vector<HandleSpec> handles;
 };
 
-/// Parses and validates the structure (types, counts, finite numbers, known names). Throws
-/// InvalidArgument with the JSON path of the first problem.
+/// Parses and validates the structure (types, counts, finite numbers, known names; unions nest at
+/// most 32 deep). Throws InvalidArgument with the JSON path of the first problem.
 EditRequest parse_edit_request(const nlohmann::json& json);
 RegionSpec parse_region(const nlohmann::json& json, const std::string& path = "region");
 TransformSpec parse_transform(const nlohmann::json& json, const std::string& path = "transform");

@@ -16,6 +16,7 @@
 #include "remora/geometry/laplacian.h"
 #include "remora/geometry/measures.h"
 #include "remora/multires/frame.h"
+#include "remora/multires/limits.h"
 #include "remora/multires/multigrid.h"
 
 namespace remora {
@@ -116,6 +117,20 @@ struct Editor::Impl {
 };
 
 namespace {
+
+/// Throws InvalidArgument when the region's estimated memory exceeds o.max_region_bytes.
+void check_region_memory(const EditorOptions& o, const RegionState& r) {
+  if (o.max_region_bytes == 0) return;
+  const auto free_vertices =
+      static_cast<std::size_t>(std::count(r.base_label.begin(), r.base_label.end(), Region::kFree));
+  const std::uint64_t need = region_bytes(free_vertices, o.system.k, r.handles);
+  if (need <= o.max_region_bytes) return;
+  throw InvalidArgument(fmt::format(
+      "the region has {} free base vertices: at k = {} with {} handle{} it needs about {} MB, "
+      "more than the {} MB a region may take here (paint a smaller support, or use a lower k)",
+      free_vertices, o.system.k, r.handles, r.handles == 1 ? "" : "s", need >> 20,
+      o.max_region_bytes >> 20));
+}
 
 void check_options(const EditorOptions& o) {
   if (o.system.k < 1 || o.system.k > 3)
@@ -465,6 +480,7 @@ void Editor::set_region(const std::vector<int>& support,
   std::unique_ptr<RegionState> state = m.paint(support, handles);
   RegionState& r = *state;
   m.map_to_base(r);
+  check_region_memory(m.options, r);
   m.report_region(r);
   m.solve_basis(r);
   m.encode_details(r);

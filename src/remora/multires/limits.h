@@ -1,0 +1,44 @@
+// The sizes the apps accept (the CLI's edit and remesh, the server) and how they follow from the
+// editor's measured memory, so that a mesh or a region too large for the machine is refused with
+// a message before the memory is allocated instead of ending in the out-of-memory killer
+// (docs/limits.md has the measurements).
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+
+namespace remora {
+
+/// The share of the physical memory the limits plan with; the rest is left to the system and to
+/// other programs.
+inline constexpr double kMemoryShare = 0.75;
+
+/// Peak resident memory of the editor's preprocessing per input triangle (loading, base surface,
+/// area-equalizing remesh, correspondence, and a small region), measured with `remora edit` on
+/// igea (269k triangles) and igea_sub4 (1.07M): 1.15-1.21 kB, linear in the mesh; with a margin.
+inline constexpr std::uint64_t kEditorBytesPerTriangle = 1536;
+
+/// Memory of a region per free base vertex for k = 1, 2, 3 (index k - 1), with one handle: the
+/// sparse Cholesky factor (which grows a little faster than the region), the basis functions and
+/// the Phong details, measured with supports covering igea_sub4 (549k free base vertices); with a
+/// margin.
+inline constexpr std::uint64_t kRegionBytesPerFreeVertex[3] = {2048, 4096, 8192};
+
+/// The memory each of `editors` editors alive at once may plan with: kMemoryShare of
+/// `memory_bytes`, split evenly. 0 (no limit) when the memory is unknown (0).
+std::uint64_t editor_memory_share(std::uint64_t memory_bytes, int editors = 1);
+
+/// The most triangles an editor's preprocessing fits in editor_memory_share() (at least 1; 0
+/// when the memory is unknown).
+std::uint64_t editor_triangle_limit(std::uint64_t memory_bytes, int editors = 1);
+
+/// The estimated memory of a region of `free_vertices` free base vertices at order k with
+/// `handles` handles (each handle beyond the first adds 4 basis columns and 4 solutions).
+std::uint64_t region_bytes(std::size_t free_vertices, int k, int handles);
+
+/// The handles an edit may have. Each handle adds four solutions to set_region and four columns
+/// per free vertex to the basis every frame blends (n_free x (3 + 4h) doubles): at 16 handles a
+/// region of 549k free base vertices (all of igea_sub4) holds a basis of 290 MB.
+inline constexpr int kMaxHandles = 16;
+
+} // namespace remora
