@@ -3,6 +3,8 @@
 # remeshing race against CGAL, which is GPL and therefore only ever built by that target.
 BUILD      ?= build
 ASAN_BUILD ?= build-asan
+TSAN_BUILD ?= build-tsan
+FUZZ_BUILD ?= build-fuzz
 ASAN_CXX   ?= clang++
 JOBS       ?= $(shell nproc)
 CMAKE_FLAGS ?=
@@ -11,7 +13,8 @@ BENCH_ARGS ?=
 PORT       ?= 8080
 
 PHONY_EXTRA = deps-web serve
-.PHONY: all deps deps-bench $(PHONY_EXTRA) build demo test test-release test-asan bench format format-check clean
+.PHONY: all deps deps-bench $(PHONY_EXTRA) build demo test test-release test-asan test-tsan fuzz soak \
+        bench format format-check clean
 
 all: build
 
@@ -25,10 +28,11 @@ deps-web:
 	@scripts/bootstrap.sh --web
 
 # REMORA_WITH_CGAL=OFF is explicit so that a build folder `make bench` configured goes back to
-# the CGAL-free default.
+# the CGAL-free default; the Google Benchmark programs are built by `make bench` only (the
+# `remora bench` commands are part of the CLI and always built).
 build: deps
 	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release -DREMORA_WERROR=ON -DREMORA_WITH_CGAL=OFF \
-	  $(CMAKE_FLAGS)
+	  -DREMORA_BUILD_BENCH=OFF $(CMAKE_FLAGS)
 	cmake --build $(BUILD) -j$(JOBS)
 
 # The quality report of the bundled scan, its area-equalizing remesh (paper §4), one edit from
@@ -69,8 +73,9 @@ bench-web: build
 	node web/tests/bench.mjs --cli $(BUILD)/bin/remora --web-root $(BUILD)/web --mesh $(MESH) $(BENCH_WEB_ARGS)
 
 # Release build with warnings as errors, the formatting check, then the unit tests again under
-# AddressSanitizer + UndefinedBehaviorSanitizer.
-test: deps-web format-check test-release test-asan
+# AddressSanitizer + UndefinedBehaviorSanitizer with a smoke run of every fuzz harness, and the
+# server's tests under ThreadSanitizer.
+test: deps-web format-check test-release test-asan test-tsan
 
 # ctest runs $(JOBS) test processes at once; OpenMP threads that spin while waiting and OpenBLAS's
 # own threads then fight over the cores (the solver tests took 15-36 s instead of 0.2-2 s), so
@@ -87,10 +92,63 @@ test-asan: deps
 	cmake -S . -B $(ASAN_BUILD) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DREMORA_WERROR=ON \
 	  -DCMAKE_CXX_COMPILER=$(ASAN_CXX) \
 	  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG" -DREMORA_SANITIZE=ON \
-	  -DREMORA_BUILD_BENCH=OFF -DREMORA_BUILD_WEB=OFF $(CMAKE_FLAGS)
+	  -DREMORA_BUILD_BENCH=OFF -DREMORA_BUILD_WEB=OFF -DREMORA_BUILD_FUZZ=ON $(CMAKE_FLAGS)
 	cmake --build $(ASAN_BUILD) -j$(JOBS)
 	cd $(ASAN_BUILD) && $(TEST_ENV) REMORA_SANITIZED=1 ASAN_OPTIONS=detect_leaks=1 \
-	  UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 ctest --output-on-failure -j$(JOBS)
+	  UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 FUZZ_NICE=0 ctest --output-on-failure -j$(JOBS)
+
+# The server's tests (test_server*.cpp: sessions, handlers, the HTTP binding, concurrent clients)
+# under ThreadSanitizer, in a build of the library, the server and those tests only. OpenMP's
+# synchronization is made visible to TSan by LLVM's Archer tool (libarcher, shipped with clang);
+# what the uninstrumented libraries (libomp, libstdc++, cpp-httplib) do inside is not checked.
+TSAN_OPTIONS_ALL = halt_on_error=1:second_deadlock_stack=1:history_size=4:ignore_noninstrumented_modules=1
+test-tsan: deps
+	cmake -S . -B $(TSAN_BUILD) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DREMORA_WERROR=ON \
+	  -DCMAKE_CXX_COMPILER=$(ASAN_CXX) \
+	  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG" -DREMORA_SANITIZE_THREAD=ON \
+	  -DREMORA_BUILD_BENCH=OFF -DREMORA_BUILD_WEB=OFF $(CMAKE_FLAGS)
+	cmake --build $(TSAN_BUILD) -j$(JOBS) --target remora_tests
+	cd $(TSAN_BUILD) && $(TEST_ENV) REMORA_SANITIZED=1 TSAN_OPTIONS=$(TSAN_OPTIONS_ALL) \
+	  OMP_TOOL_LIBRARIES=$$($(ASAN_CXX) -print-resource-dir)/../../libarcher.so \
+	  ctest --output-on-failure -j$(JOBS)
+
+# Coverage-guided fuzzing (docs/fuzzing.md): every harness for FUZZ_SECONDS (default 180) in a
+# clang build with ASan + UBSan, assertions on and our code instrumented for libFuzzer; corpora
+# grow in $(FUZZ_BUILD)/fuzz-corpus, crashing inputs are kept in $(FUZZ_BUILD)/fuzz-crashes.
+# ASan records no allocation stacks here (a fifth of the time of a small input); replaying a
+# kept input with the harness alone gives them.
+# FUZZ_HARNESSES picks some (e.g. "obj server"). Runs under nice -n 19. Not part of `make test`.
+FUZZ_SECONDS   ?= 180
+FUZZ_HARNESSES ?=
+fuzz: deps
+	cmake -S . -B $(FUZZ_BUILD) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DREMORA_WERROR=ON \
+	  -DCMAKE_CXX_COMPILER=$(ASAN_CXX) -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -g1" \
+	  -DREMORA_SANITIZE=ON -DREMORA_BUILD_FUZZ=ON -DREMORA_FUZZ_COVERAGE=ON \
+	  -DREMORA_BUILD_TESTS=OFF -DREMORA_BUILD_BENCH=OFF -DREMORA_BUILD_WEB=OFF $(CMAKE_FLAGS)
+	cmake --build $(FUZZ_BUILD) -j$(JOBS) --target remora_fuzzers
+	FUZZ_SECONDS=$(FUZZ_SECONDS) ASAN_OPTIONS=detect_leaks=1:malloc_context_size=0 \
+	  UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 scripts/fuzz.sh $(FUZZ_BUILD) $(FUZZ_HARNESSES)
+
+# The soak of `remora serve` (scripts/soak.py; docs/server.md): SOAK_SECONDS (default 600) of
+# random valid and invalid requests from SOAK_CLIENTS clients on loopback against one server on
+# SOAK_MESH, with its memory sampled, every answer checked and the final state compared with a
+# replay of the accepted requests; the report goes to $(BUILD)/soak.json. Under nice -n 19.
+# Not part of `make test`.
+SOAK_SECONDS ?= 600
+SOAK_CLIENTS ?= 4
+SOAK_MESH    ?= data/bunny.ply
+soak: build
+	nice -n 19 python3 scripts/soak.py --cli $(BUILD)/bin/remora --mesh $(SOAK_MESH) \
+	  --seconds $(SOAK_SECONDS) --clients $(SOAK_CLIENTS) --report $(BUILD)/soak.json
+
+# Every mesh of the shared data (DATA, default ../shared/data: the paths its MANIFEST.md lists)
+# through load, preprocessing and an edit with its checks (remora bench pipeline); the table
+# goes to stdout and $(BUILD)/pipeline-data.md (docs/benchmarks.md keeps it). Not in `make test`.
+DATA ?= $(or $(REMORA_DATA),../shared/data)
+.PHONY: pipeline-data
+pipeline-data: build
+	$(BUILD)/bin/remora bench pipeline $(DATA) > $(BUILD)/pipeline-data.md; status=$$?; \
+	  cat $(BUILD)/pipeline-data.md; exit $$status
 
 # Release build with the CGAL race, then loading speed (remora_bench) and the race
 # (remora_bench_remesh). BENCH_ARGS go to the race, e.g. make bench BENCH_ARGS="--large --json".
@@ -110,4 +168,4 @@ format-check:
 	@clang-format --dry-run --Werror $(FORMAT_FILES) && echo "format-check: clean"
 
 clean:
-	rm -rf $(BUILD) $(ASAN_BUILD)
+	rm -rf $(BUILD) $(ASAN_BUILD) $(TSAN_BUILD) $(FUZZ_BUILD)
