@@ -124,7 +124,7 @@ TEST(Limits, VertexRecordsAreCappedAtThreePerTriangle) {
 TEST(Limits, TheTriangleLimitFollowsTheMachinesMemory) {
   const std::uint64_t gb24 = 24ull << 30;
   EXPECT_EQ(editor_triangle_limit(gb24, 1),
-            static_cast<std::uint64_t>(kMemoryShare * double(gb24) / kEditorBytesPerTriangle));
+            static_cast<std::uint64_t>(kMemoryShare * double(gb24)) / kMeshBytesPerTriangle);
   EXPECT_EQ(editor_triangle_limit(gb24, 4), editor_triangle_limit(gb24, 1) / 4);
   EXPECT_EQ(editor_triangle_limit(0, 1), 0u);    // unknown: no limit
   EXPECT_EQ(editor_triangle_limit(1000, 1), 1u); // never below one triangle
@@ -143,7 +143,9 @@ TEST(Limits, ARegionOverItsMemoryIsRefusedBeforeTheFactorization) {
     if (sphere.point(v)[2] < -0.95) pole.push_back(v.idx());
   }
   EditorOptions options;
-  options.max_region_bytes = region_bytes(cap.size() * 2, 2, 1); // room for the cap, not all
+  // Room for the preprocessing and the cap's region, not for all of it.
+  options.memory_bytes =
+      kEditorBytesPerTriangle * sphere.n_faces() + region_bytes(cap.size() * 2, 2, 1);
   Editor editor(sphere, options);
   editor.set_region(cap, {top});
   const std::size_t cap_movable = editor.movable_vertices().size();
@@ -218,7 +220,7 @@ TEST(Limits, TheServerRefusesAMeshOverItsLimitAndRegionsOverTheirs) {
   EXPECT_EQ(SessionOptions{}.max_handles, kMaxHandles);
   // A region over the editor's memory: the job fails with the message, the session goes on.
   SessionOptions tight;
-  tight.editor.max_region_bytes = 1000;
+  tight.editor.memory_bytes = 1000;
   Session t(tight);
   ASSERT_EQ(call(t, "POST", "/api/load", sphere_off(), {{"name", "s.off"}}).status, 202);
   t.wait();

@@ -248,7 +248,7 @@ EditorOptions editor_options(const EditRequest& request, const EditArgs& a) {
   if (a.length_factor > 0) options.remesh_options.length_factor = a.length_factor;
   if (a.no_remesh) options.remesh = false;
   options.threads = a.threads;
-  options.max_region_bytes = editor_memory_share(physical_memory_bytes(), 1);
+  options.memory_bytes = editor_memory_share(physical_memory_bytes(), 1);
   // The unsymmetric system needs a solver for it.
   if (options.system.areas == AreaWeights::Mixed && options.solver.name.empty())
     options.solver.name = "lu";

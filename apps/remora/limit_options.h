@@ -22,7 +22,7 @@ inline void add_max_triangles_option(CLI::App* cmd, std::uint64_t& max, int edit
       memory == 0 ? std::string("the machine's memory is unknown")
                   : fmt::format("{:.0f} % of this machine's {:.1f} GB at {:.1f} kB per triangle{}",
                                 100 * kMemoryShare, double(memory) / 1e9,
-                                double(kEditorBytesPerTriangle) / 1024,
+                                double(kMeshBytesPerTriangle) / 1000,
                                 editors > 1 ? fmt::format(" for {} editors", editors) : "");
   cmd->add_option("--max-triangles", max,
                   fmt::format("Largest mesh accepted, in triangles; a larger file is refused "

@@ -67,7 +67,7 @@ void add_serve_command(CLI::App& app) {
     server::SessionOptions options;
     options.threads = a->threads;
     options.max_editors = static_cast<std::size_t>(a->history_editors);
-    options.editor.max_region_bytes =
+    options.editor.memory_bytes =
         editor_memory_share(physical_memory_bytes(), a->history_editors + 1);
     options.read.max_triangles = a->max_triangles;
     options.max_handles = a->max_handles;

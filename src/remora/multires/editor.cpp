@@ -118,18 +118,20 @@ struct Editor::Impl {
 
 namespace {
 
-/// Throws InvalidArgument when the region's estimated memory exceeds o.max_region_bytes.
-void check_region_memory(const EditorOptions& o, const RegionState& r) {
-  if (o.max_region_bytes == 0) return;
+/// Throws InvalidArgument when the region's estimated memory and the preprocessing's of
+/// `triangles` input triangles exceed o.memory_bytes.
+void check_region_memory(const EditorOptions& o, std::size_t triangles, const RegionState& r) {
+  if (o.memory_bytes == 0) return;
   const auto free_vertices =
       static_cast<std::size_t>(std::count(r.base_label.begin(), r.base_label.end(), Region::kFree));
+  const std::uint64_t held = kEditorBytesPerTriangle * triangles;
   const std::uint64_t need = region_bytes(free_vertices, o.system.k, r.handles);
-  if (need <= o.max_region_bytes) return;
+  if (held + need <= o.memory_bytes) return;
   throw InvalidArgument(fmt::format(
       "the region has {} free base vertices: at k = {} with {} handle{} it needs about {} MB, "
-      "more than the {} MB a region may take here (paint a smaller support, or use a lower k)",
-      free_vertices, o.system.k, r.handles, r.handles == 1 ? "" : "s", need >> 20,
-      o.max_region_bytes >> 20));
+      "more than the {} MB left to a region here (paint a smaller support, or use a lower k)",
+      free_vertices, o.system.k, r.handles, r.handles == 1 ? "" : "s", need / 1000000,
+      (o.memory_bytes > held ? o.memory_bytes - held : 0) / 1000000));
 }
 
 void check_options(const EditorOptions& o) {
@@ -480,7 +482,7 @@ void Editor::set_region(const std::vector<int>& support,
   std::unique_ptr<RegionState> state = m.paint(support, handles);
   RegionState& r = *state;
   m.map_to_base(r);
-  check_region_memory(m.options, r);
+  check_region_memory(m.options, m.input.n_faces(), r);
   m.report_region(r);
   m.solve_basis(r);
   m.encode_details(r);

@@ -81,9 +81,10 @@ struct EditorOptions {
   DetailMode details = DetailMode::Normal;
   PhongOptions phong;
   int threads = 0; ///< 0 = all hardware threads
-  /// set_region refuses (InvalidArgument) a region whose estimated memory, region_bytes() of
-  /// multires/limits.h, exceeds this many bytes; 0 = no limit.
-  std::uint64_t max_region_bytes = 0;
+  /// The memory this editor may plan with (0 = no limit): set_region refuses (InvalidArgument) a
+  /// region whose estimate (region_bytes() of multires/limits.h) added to the preprocessing's
+  /// (kEditorBytesPerTriangle per input triangle) exceeds it.
+  std::uint64_t memory_bytes = 0;
   /// Called at the start of every phase: (phase name, step, number of steps).
   std::function<void(std::string_view phase, int step, int steps)> progress;
 };
@@ -133,7 +134,7 @@ public:
   /// identity. Throws InvalidArgument for an empty support, no handle, an empty handle, an id out
   /// of range, a handle vertex outside the support or in two handles, a support that maps to no
   /// free base vertex, a support component (on the base) with no constrained vertex, or a region
-  /// over options().max_region_bytes (checked before the factorization); throws NumericalError
+  /// over options().memory_bytes (checked before the factorization); throws NumericalError
   /// when the solver fails. On a throw the previous region stays in place.
   void set_region(const std::vector<int>& support, const std::vector<std::vector<int>>& handles);
 

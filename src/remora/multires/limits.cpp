@@ -11,7 +11,7 @@ std::uint64_t editor_memory_share(std::uint64_t memory_bytes, int editors) {
 std::uint64_t editor_triangle_limit(std::uint64_t memory_bytes, int editors) {
   if (memory_bytes == 0) return 0;
   return std::max<std::uint64_t>(1, editor_memory_share(memory_bytes, editors) /
-                                        kEditorBytesPerTriangle);
+                                        kMeshBytesPerTriangle);
 }
 
 std::uint64_t region_bytes(std::size_t free_vertices, int k, int handles) {

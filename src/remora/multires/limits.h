@@ -15,7 +15,7 @@ inline constexpr double kMemoryShare = 0.75;
 
 /// Peak resident memory of the editor's preprocessing per input triangle (loading, base surface,
 /// area-equalizing remesh, correspondence, and a small region), measured with `remora edit` on
-/// igea (269k triangles) and igea_sub4 (1.07M): 1.15-1.21 kB, linear in the mesh; with a margin.
+/// igea (269k triangles) and igea_sub4 (1.07M): 1.17-1.21 kB, linear in the mesh; with a margin.
 inline constexpr std::uint64_t kEditorBytesPerTriangle = 1536;
 
 /// Memory of a region per free base vertex for k = 1, 2, 3 (index k - 1), with one handle: the
@@ -28,8 +28,13 @@ inline constexpr std::uint64_t kRegionBytesPerFreeVertex[3] = {2048, 4096, 8192}
 /// `memory_bytes`, split evenly. 0 (no limit) when the memory is unknown (0).
 std::uint64_t editor_memory_share(std::uint64_t memory_bytes, int editors = 1);
 
-/// The most triangles an editor's preprocessing fits in editor_memory_share() (at least 1; 0
-/// when the memory is unknown).
+/// What the mesh limit plans per triangle: the preprocessing and a region covering the whole mesh
+/// at k = 2 (0.51 free base vertices per input triangle on igea_sub4, at
+/// kRegionBytesPerFreeVertex[1] each).
+inline constexpr std::uint64_t kMeshBytesPerTriangle = kEditorBytesPerTriangle + 2048;
+
+/// The most triangles an editor fits in editor_memory_share() with a region over all of them at
+/// k = 2 (kMeshBytesPerTriangle; at least 1; 0 when the memory is unknown).
 std::uint64_t editor_triangle_limit(std::uint64_t memory_bytes, int editors = 1);
 
 /// The estimated memory of a region of `free_vertices` free base vertices at order k with
