@@ -391,6 +391,18 @@ TEST_F(Cli, EditRefusesBadRequestsAndWritesNothing) {
   }
 }
 
+// A file name that is not UTF-8 (Latin-1 on a Linux file system) is written into --json replaced
+// by U+FFFD; the command succeeds.
+TEST_F(Cli, JsonReportsOfFilesNamedInAnotherEncodingParse) {
+  const fs::path in = dir_ / "\xe9t\xe9.off";
+  write_mesh(in.string(), make_icosphere(1, 1.0));
+  const CliRun r = run("info --json '" + in.string() + "'");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out, nullptr, false);
+  ASSERT_FALSE(j.is_discarded()) << r.out;
+  EXPECT_NE(j["load"]["path"].get<std::string>().find("\xef\xbf\xbd"), std::string::npos);
+}
+
 // The limits of docs/limits.md on the command line: a mesh over --max-triangles is refused before
 // the work, an edit with more handles than --max-handles too, and no output file is left.
 TEST_F(Cli, EditAndRemeshRefuseWhatIsOverTheirLimits) {

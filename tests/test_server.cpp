@@ -295,6 +295,37 @@ TEST(Server, TheHistoryKeepsFewEditorsAlive) {
   EXPECT_FALSE(json::parse(call(s, "POST", "/api/undo").body)["changed"]);
 }
 
+// Bytes that are not UTF-8 (in a path, a JSON key, a file name a client sent) come back in the
+// JSON answers as U+FFFD: the answers parse, and nothing is a 500.
+TEST(Server, BytesThatAreNotUtf8ComeBackReplacedInJson) {
+  Session s;
+  const auto parses = [](const HttpResponse& r) { return json::accept(r.body); };
+  const HttpResponse path = call(s, "GET", "/api/\xff\xfe");
+  EXPECT_EQ(path.status, 404);
+  EXPECT_TRUE(parses(path)) << path.body;
+  const HttpResponse key = call(s, "POST", "/api/region", "{\"\xff\": 1}");
+  EXPECT_EQ(key.status, 400);
+  EXPECT_TRUE(parses(key)) << key.body;
+  // A broken upload named in Latin-1: the status names it, replaced, and parses.
+  const std::string latin1 = "\xe9t\xe9.off";
+  ASSERT_EQ(call(s, "POST", "/api/load", "OFF\n3 1 0\n0 0 0\n1 0 nan\n0 1 0\n3 0 1 2\n",
+                 {{"name", latin1}})
+                .status,
+            202);
+  s.wait();
+  HttpResponse st = call(s, "GET", "/api/status");
+  ASSERT_EQ(st.status, 200) << st.body;
+  EXPECT_NE(json::parse(st.body).value("error", "").find("\xef\xbf\xbd"), std::string::npos);
+  // The same name on a good mesh: every later status carries it.
+  ASSERT_EQ(call(s, "POST", "/api/load", sphere_off(), {{"name", latin1}}).status, 202);
+  s.wait();
+  st = call(s, "GET", "/api/status");
+  ASSERT_EQ(st.status, 200) << st.body;
+  EXPECT_EQ(json::parse(st.body)["state"], "ready");
+  EXPECT_NE(json::parse(st.body)["mesh"]["name"].get<std::string>().find("t\xef\xbf\xbd.off"),
+            std::string::npos);
+}
+
 TEST(Server, StaticFilesStayInsideTheRoot) {
   const auto root = std::filesystem::temp_directory_path() / "remora_web_root_test";
   std::filesystem::create_directories(root / "three");

@@ -18,6 +18,7 @@
 
 #include "commands.h"
 #include "remora/common/error.h"
+#include "remora/common/json.h"
 #include "remora/common/timer.h"
 #include "remora/geometry/selection.h"
 #include "remora/linalg/kharmonic.h"
@@ -350,7 +351,7 @@ void run_bench_solvers(const SolversArgs& a) {
     if (!a.json) print_support_table(support, assemble_s, rows);
   }
   if (a.json) {
-    std::cout << out.dump(2) << "\n";
+    std::cout << dump_json(out, 2) << "\n";
     return;
   }
   std::cout << "\nThe paper's Table 1 (2004, 3 GHz P4), precomputation / 3 solutions: 15k free "

@@ -12,6 +12,7 @@
 
 #include "commands.h"
 #include "remora/common/error.h"
+#include "remora/common/json.h"
 #include "remora/common/timer.h"
 #include "remora/geometry/measures.h"
 #include "remora/geometry/selection.h"
@@ -88,7 +89,7 @@ void print_bench_edit(const BenchEditArgs& a, const EditReport& r, const BenchEd
                   {"frame_ms_max", t.frames.back()},
                   {"frame_parts_ms_median", t.frame_parts},
                   {"frames", t.frames.size()}};
-    std::cout << j.dump(2) << "\n";
+    std::cout << dump_json(j, 2) << "\n";
     return;
   }
   std::cout << fmt::format("mesh {}: {} vertices, {} faces; base {} vertices\n", a.mesh,

@@ -19,6 +19,7 @@
 
 #include "commands.h"
 #include "remora/common/error.h"
+#include "remora/common/json.h"
 #include "remora/common/timer.h"
 #include "remora/geometry/measures.h"
 #include "remora/geometry/selection.h"
@@ -163,7 +164,7 @@ void print_rows(const std::vector<PipelineRow>& rows, bool json) {
                      {"identity_error", r.identity_error},
                      {"handle_moved", r.handle_moved},
                      {"failures", r.failures}});
-    std::cout << out.dump(2) << "\n";
+    std::cout << dump_json(out, 2) << "\n";
     return;
   }
   std::cout << "| mesh | V | F | base V | support | handle | load ms | preprocess ms | "

@@ -21,6 +21,7 @@
 #include "commands.h"
 #include "http.h"
 #include "remora/common/error.h"
+#include "remora/common/json.h"
 #include "remora/common/timer.h"
 #include "remora/geometry/selection.h"
 #include "remora/mesh/io.h"
@@ -192,7 +193,7 @@ void run_bench_serve(const BenchServeArgs& a) {
                                  {"brush_vertices", brush},
                                  {"requests", a.requests}};
   if (a.json) {
-    std::cout << result.dump(2) << "\n";
+    std::cout << dump_json(result, 2) << "\n";
     return;
   }
   std::cout << fmt::format(

@@ -11,6 +11,7 @@
 #include "commands.h"
 #include "limit_options.h"
 #include "remora/common/error.h"
+#include "remora/common/json.h"
 #include "remora/common/timer.h"
 #include "remora/geometry/measures.h"
 #include "remora/mesh/io.h"
@@ -297,7 +298,7 @@ void report_edit(const EditArgs& a, Editor& editor, const Selection& s, double l
     j["milliseconds"]["load"] = load_ms;
     j["result"] = {
         {"output", a.out}, {"max_move_relative", max_move}, {"detail_retention", retention}};
-    std::cout << j.dump(2) << "\n";
+    std::cout << dump_json(j, 2) << "\n";
     return;
   }
   print_edit_report(std::cout, editor.report(), load_ms, retention, max_move);

@@ -4,6 +4,7 @@
 #include <spdlog/spdlog.h>
 
 #include "commands.h"
+#include "remora/common/json.h"
 #include "remora/common/timer.h"
 #include "remora/geometry/quality.h"
 #include "remora/mesh/io.h"
@@ -28,7 +29,7 @@ void add_info_command(CLI::App& app) {
     if (*json) {
       nlohmann::json j = to_json(quality);
       j["load"] = to_json(loaded.report);
-      std::cout << j.dump(2) << "\n";
+      std::cout << dump_json(j, 2) << "\n";
       return;
     }
     print_load_report(std::cout, loaded.report);

@@ -7,6 +7,7 @@
 
 #include "commands.h"
 #include "limit_options.h"
+#include "remora/common/json.h"
 #include "remora/linalg/kharmonic.h"
 #include "remora/mesh/io.h"
 #include "remora/multires/base_surface.h"
@@ -250,7 +251,7 @@ void run_remesh(const RemeshArgs& a) {
                        {"sigma_min", low_pass->sigma_min},
                        {"sigma_capped_vertices", low_pass->capped},
                        {"sigma_capped_loops", low_pass->capped_loops}};
-    std::cout << j.dump(2) << "\n";
+    std::cout << dump_json(j, 2) << "\n";
     return;
   }
   if (a.report && low_pass)

@@ -3,6 +3,8 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "remora/common/json.h"
+
 // Last: httplib.h pulls in <resolv.h>, whose `_res` macro breaks Eigen's headers if they follow.
 #include <httplib.h> // NOLINT(llvm-include-order)
 
@@ -67,7 +69,7 @@ void bind_http(httplib::Server& http, Session& session, const ApiLimits& limits,
   // Called for every answer of 400 and above: ours already have a body.
   http.set_error_handler([&limits](const httplib::Request& req, httplib::Response& res) {
     if (!res.body.empty()) return;
-    res.set_content(nlohmann::json{{"error", transport_error(req, res.status, limits)}}.dump(),
+    res.set_content(dump_json({{"error", transport_error(req, res.status, limits)}}),
                     "application/json");
   });
 }
