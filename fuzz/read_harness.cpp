@@ -1,14 +1,14 @@
-#include "read_harness.h"
-
+// run_reader() and run_harness() of harness.h.
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <string_view>
+#include <utility>
 
 #include <OpenMesh/Tools/Utils/MeshCheckerT.hh>
 
+#include "harness.h"
 #include "inputs.h"
 #include "remora/common/error.h"
 #include "remora/mesh/io.h"
@@ -18,8 +18,7 @@ namespace remora::fuzz {
 namespace {
 
 [[noreturn]] void fail(const std::string& what) {
-  std::fprintf(stderr, "remora fuzz check failed: %s\n", what.c_str());
-  std::abort();
+  throw CheckFailed(what);
 }
 
 void check(bool ok, const std::string& what) {
@@ -44,7 +43,7 @@ std::pair<std::string, std::string> file_of(ReaderVariant variant, std::string_v
   case ReaderVariant::StlBinary:
     return {binary_stl_file(input), "fuzz.stl"};
   }
-  std::abort();
+  throw std::invalid_argument("unknown reader variant");
 }
 
 /// What every loaded mesh promises (io.h, repair.h, docs/io.md): faces, finite points, a valid
@@ -79,14 +78,13 @@ void check_loaded(const LoadResult& r) {
 
 } // namespace
 
-int run_reader(ReaderVariant variant, const std::uint8_t* data, std::size_t size) {
-  const auto [file, name] =
-      file_of(variant, std::string_view(reinterpret_cast<const char*>(data), size));
+void run_reader(ReaderVariant variant, std::string_view input) {
+  const auto [file, name] = file_of(variant, input);
   LoadResult loaded;
   try {
     loaded = read_mesh_from_memory(file, format_from_path(name), name);
   } catch (const IoError&) {
-    return 0; // the clean refusal every malformed file gets
+    return; // the clean refusal every malformed file gets
   }
   check_loaded(loaded);
   // Loading is idempotent: the loaded mesh, written exactly (binary PLY of doubles) and read
@@ -96,7 +94,22 @@ int run_reader(ReaderVariant variant, const std::uint8_t* data, std::size_t size
   check(reloaded.mesh.n_faces() == loaded.mesh.n_faces(),
         "a loaded mesh written and read again has " + std::to_string(reloaded.mesh.n_faces()) +
             " faces instead of " + std::to_string(loaded.mesh.n_faces()));
-  return 0;
+}
+
+void run_harness(const std::string& name, std::string_view input) {
+  static const std::pair<const char*, ReaderVariant> readers[] = {
+      {"obj", ReaderVariant::Obj},
+      {"off", ReaderVariant::Off},
+      {"ply_ascii", ReaderVariant::PlyAscii},
+      {"ply_binary", ReaderVariant::PlyBinary},
+      {"ply_tristrips", ReaderVariant::PlyTristrips},
+      {"stl_ascii", ReaderVariant::StlAscii},
+      {"stl_binary", ReaderVariant::StlBinary}};
+  for (const auto& [reader, variant] : readers)
+    if (name == reader) return run_reader(variant, input);
+  if (name == "edit_request") return run_edit_request(input);
+  if (name == "server") return run_server_script(input);
+  throw std::invalid_argument("no fuzz harness '" + name + "'");
 }
 
 } // namespace remora::fuzz
