@@ -82,9 +82,11 @@ struct Editor::Impl {
   std::optional<LowPassFilter> filter;
   Mesh base;
   TriangleTopology topology;
-  Eigen::MatrixXd base_rest; // B
+  Eigen::MatrixXd base_rest;    // B
+  Eigen::MatrixXd base_normals; // of B
   std::vector<SurfacePoint> base_on_input, input_on_base;
   std::vector<std::pair<int, int>> negative_edges; // of B
+  std::optional<KHarmonicAssembler> assembler;     // B's systems
   std::unique_ptr<MultigridSolver> multigrid;
   EditReport report;
   std::unique_ptr<RegionState> region;
@@ -107,11 +109,11 @@ struct Editor::Impl {
   std::unique_ptr<RegionState> paint(const std::vector<int>& support,
                                      const std::vector<std::vector<int>>& handles) const;
   void map_to_base(RegionState& r) const;
-  void report_region(const RegionState& r);
+  void report_region(const RegionState& r, EditReport& out) const;
   Eigen::MatrixXd constrained_values(const RegionState& r, const std::vector<int>& vertices,
                                      bool by_vertex) const;
-  void solve_basis(RegionState& r);
-  void encode_details(RegionState& r);
+  void solve_basis(RegionState& r, EditReport& out, const std::stop_token& stop);
+  void encode_details(RegionState& r, EditReport& out, const std::stop_token& stop) const;
   void find_affected(RegionState& r) const;
 };
 
@@ -207,15 +209,17 @@ Editor::Editor(Mesh mesh, EditorOptions options) : impl_(std::make_unique<Impl>(
   }
   m.topology = triangle_topology(m.base);
   m.base_rest = positions_matrix(m.base);
+  m.base_normals = vertex_normals(m.topology, m.base_rest);
   m.report.milliseconds["remesh"] = ms_since(t0);
   m.report.base_vertices = m.base.n_vertices();
   m.report.base_faces = m.base.n_faces();
 
   t0 = Clock::now();
-  const Eigen::SparseMatrix<double> w = cotan_weights(m.base);
-  for (Eigen::Index c = 0; c < w.outerSize(); ++c)
-    for (Eigen::SparseMatrix<double>::InnerIterator it(w, c); it; ++it)
-      if (it.row() < it.col() && it.value() < 0.0)
+  m.assembler.emplace(m.base, m.options.threads);
+  const SparseMatrix& minus_w = m.assembler->minus_w();
+  for (Eigen::Index c = 0; c < minus_w.outerSize(); ++c)
+    for (SparseMatrix::InnerIterator it(minus_w, c); it; ++it)
+      if (it.row() < it.col() && it.value() > 0.0)
         m.negative_edges.emplace_back(static_cast<int>(it.row()), static_cast<int>(it.col()));
   m.report.base_symmetry_defect = laplacian_symmetry_defect(m.base);
   m.report.base_quality = mesh_quality(m.base);
@@ -301,25 +305,25 @@ void Editor::Impl::map_to_base(RegionState& r) const {
       r.handle_base[static_cast<std::size_t>(r.base_label[v])].push_back(static_cast<int>(v));
 }
 
-// The region's figures, before the solve, so that a failing solve still reports them.
-void Editor::Impl::report_region(const RegionState& r) {
-  report.support_vertices = 0;
-  report.handle_vertices.assign(static_cast<std::size_t>(r.handles), 0);
+// The region's figures (the report takes them only when the whole of set_region succeeds).
+void Editor::Impl::report_region(const RegionState& r, EditReport& out) const {
+  out.support_vertices = 0;
+  out.handle_vertices.assign(static_cast<std::size_t>(r.handles), 0);
   for (const int label : r.input_label) {
-    if (label != Region::kFixed) ++report.support_vertices;
-    if (label >= 0) ++report.handle_vertices[static_cast<std::size_t>(label)];
+    if (label != Region::kFixed) ++out.support_vertices;
+    if (label >= 0) ++out.handle_vertices[static_cast<std::size_t>(label)];
   }
   std::size_t free_count = 0, constrained = 0;
   for (const int label : r.base_label) (label == Region::kFree ? free_count : constrained)++;
-  report.free_base_vertices = free_count;
-  report.constrained_base_vertices = constrained;
-  report.handle_base_vertices.clear();
-  for (const auto& h : r.handle_base) report.handle_base_vertices.push_back(h.size());
-  report.negative_weights_in_support = 0;
+  out.free_base_vertices = free_count;
+  out.constrained_base_vertices = constrained;
+  out.handle_base_vertices.clear();
+  for (const auto& h : r.handle_base) out.handle_base_vertices.push_back(h.size());
+  out.negative_weights_in_support = 0;
   for (const auto& [a, b] : negative_edges)
     if (r.base_label[static_cast<std::size_t>(a)] == Region::kFree ||
         r.base_label[static_cast<std::size_t>(b)] == Region::kFree)
-      ++report.negative_weights_in_support;
+      ++out.negative_weights_in_support;
 }
 
 // The constrained values of the 3 + 4h basis functions, one column each: the fixed vertices'
@@ -349,11 +353,11 @@ Eigen::MatrixXd Editor::Impl::constrained_values(const RegionState& r,
 }
 
 // The system on the base, factored once; the 3 + 4h basis functions.
-void Editor::Impl::solve_basis(RegionState& r) {
+void Editor::Impl::solve_basis(RegionState& r, EditReport& out, const std::stop_token& stop) {
   const Region labels{r.base_label};
   const std::string on_base =
       options.remesh
-          ? fmt::format("on the remeshed base (edge length {:.4g}): ", report.base_target_length)
+          ? fmt::format("on the remeshed base (edge length {:.4g}): ", out.base_target_length)
           : std::string("on the mesh itself: ");
   auto t0 = Clock::now();
   const std::string name = solver_name(options.system.areas != AreaWeights::Mixed);
@@ -368,8 +372,8 @@ void Editor::Impl::solve_basis(RegionState& r) {
         multigrid = std::make_unique<MultigridSolver>(base, mo);
       }
       multigrid->set_region(labels);
-      report.milliseconds["assemble"] = 0.0;
-      report.milliseconds["factor"] = ms_since(t0);
+      out.milliseconds["assemble"] = 0.0;
+      out.milliseconds["factor"] = ms_since(t0);
       t0 = Clock::now();
       std::vector<int> all(base.n_vertices());
       for (std::size_t v = 0; v < all.size(); ++v) all[v] = static_cast<int>(v);
@@ -378,38 +382,41 @@ void Editor::Impl::solve_basis(RegionState& r) {
       int iterations = 0;
       for (const auto& level : multigrid->stats())
         iterations = std::max(iterations, level.iterations);
-      report.solver_stats = SolverStats{};
-      report.solver_stats.iterations = iterations;
+      out.solver_stats = SolverStats{};
+      out.solver_stats.iterations = iterations;
     } else {
-      const KHarmonicSystem system = assemble_kharmonic(base, labels, options.system);
-      report.milliseconds["assemble"] = ms_since(t0);
+      const KHarmonicSystem system = assembler->assemble(labels, options.system);
+      out.milliseconds["assemble"] = ms_since(t0);
       t0 = Clock::now();
       SolverOptions so = options.solver;
       so.name = name;
       const std::unique_ptr<Solver> solver = make_solver(so);
+      if (stop.stop_requested()) return;
       solver->compute(system.matrix);
-      report.milliseconds["factor"] = ms_since(t0);
+      out.milliseconds["factor"] = ms_since(t0);
+      if (stop.stop_requested()) return;
       t0 = Clock::now();
       r.basis =
           solver->solve(system.rhs(constrained_values(r, system.constrained_vertices, false)));
       r.free_vertices = system.free_vertices;
-      report.solver_stats = solver->stats();
+      out.solver_stats = solver->stats();
     }
   } catch (const InvalidArgument& e) {
     throw InvalidArgument(on_base + e.what());
   } catch (const NumericalError& e) {
     throw NumericalError(on_base + e.what());
   }
-  report.milliseconds["solve"] = ms_since(t0);
-  report.solver = name;
-  report.solves = 3 + 4 * r.handles;
+  out.milliseconds["solve"] = ms_since(t0);
+  out.solver = name;
+  out.solves = 3 + 4 * r.handles;
   if (!r.basis.allFinite())
     throw NumericalError(on_base + "the solver returned non-finite values; try a direct solver");
 }
 
-// B0 (the fill-in with the handles undeformed), its normals, and the Phong details of the painted
-// input vertices against it.
-void Editor::Impl::encode_details(RegionState& r) {
+// B0 (the fill-in with the handles undeformed), its normals (B's outside r.affected, where no face
+// moved), and the Phong details of the painted input vertices against it.
+void Editor::Impl::encode_details(RegionState& r, EditReport& out,
+                                  const std::stop_token& stop) const {
   const auto t0 = Clock::now();
   r.rest = base_rest;
   for (std::size_t row = 0; row < r.free_vertices.size(); ++row) {
@@ -418,7 +425,8 @@ void Editor::Impl::encode_details(RegionState& r) {
       p += r.basis.block<1, 3>(static_cast<Eigen::Index>(row), 3 + 4 * j);
     r.rest.row(r.free_vertices[row]) = p;
   }
-  r.rest_normals = vertex_normals(topology, r.rest);
+  r.rest_normals = base_normals;
+  update_vertex_normals(topology, r.rest, r.affected.vertices, r.rest_normals, options.threads);
   std::vector<int> starts;
   for (std::size_t i = 0; i < r.input_label.size(); ++i) {
     const SurfacePoint& sp = input_on_base[i];
@@ -429,8 +437,9 @@ void Editor::Impl::encode_details(RegionState& r) {
   Eigen::MatrixXd points(static_cast<Eigen::Index>(r.encoded.size()), 3);
   for (std::size_t e = 0; e < r.encoded.size(); ++e)
     points.row(static_cast<Eigen::Index>(e)) = input_positions.row(r.encoded[e]);
+  if (stop.stop_requested()) return;
   r.details = encode_phong(topology, r.rest, r.rest_normals, points, starts, options.phong,
-                           &report.phong, options.threads);
+                           &out.phong, options.threads);
   if (options.details == DetailMode::Displacement) {
     r.rest_offsets.resize(r.details.size());
     for (std::size_t e = 0; e < r.details.size(); ++e) {
@@ -441,7 +450,7 @@ void Editor::Impl::encode_details(RegionState& r) {
                           decode_phong(topology, r.rest, r.rest_normals, foot);
     }
   }
-  report.milliseconds["encode"] = ms_since(t0);
+  out.milliseconds["encode"] = ms_since(t0);
 }
 
 // The base vertices whose normals can change: every corner of a face with a moving vertex.
@@ -459,23 +468,32 @@ void Editor::Impl::find_affected(RegionState& r) const {
 }
 
 void Editor::set_region(const std::vector<int>& support,
-                        const std::vector<std::vector<int>>& handles) {
+                        const std::vector<std::vector<int>>& handles, const std::stop_token& stop) {
   Impl& m = *impl_;
   const auto t_start = Clock::now();
+  const auto check = [&] {
+    if (stop.stop_requested())
+      throw Cancelled("set_region was cancelled; the previous region stays in place");
+  };
+  EditReport out = m.report;
   std::unique_ptr<RegionState> state = m.paint(support, handles);
   RegionState& r = *state;
   m.map_to_base(r);
-  m.report_region(r);
-  m.solve_basis(r);
-  m.encode_details(r);
+  m.report_region(r, out);
+  check();
+  m.solve_basis(r, out, stop);
+  check();
   m.find_affected(r);
+  m.encode_details(r, out, stop);
+  check();
   r.transforms.assign(static_cast<std::size_t>(r.handles), identity_transform());
   r.current_base = r.rest;
   r.current_normals = r.rest_normals;
   r.current_positions = m.input_positions;
   r.dirty = true;
+  out.milliseconds["set_region"] = ms_since(t_start);
   m.region = std::move(state);
-  m.report.milliseconds["set_region"] = ms_since(t_start);
+  m.report = std::move(out);
 }
 
 namespace {

@@ -28,6 +28,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <stop_token>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -130,8 +131,11 @@ public:
   /// identity. Throws InvalidArgument for an empty support, no handle, an empty handle, an id out
   /// of range, a handle vertex outside the support or in two handles, a support that maps to no
   /// free base vertex, or a support component (on the base) with no constrained vertex; throws
-  /// NumericalError when the solver fails. On a throw the previous region stays in place.
-  void set_region(const std::vector<int>& support, const std::vector<std::vector<int>>& handles);
+  /// NumericalError when the solver fails, and Cancelled when `stop` is triggered (checked between
+  /// the steps; a factorization runs to its end). On a throw the previous region and the report
+  /// stay as they were.
+  void set_region(const std::vector<int>& support, const std::vector<std::vector<int>>& handles,
+                  const std::stop_token& stop = {});
 
   int handle_count() const;
   /// The vertices of O that can move under the current region (the support, handles included),
