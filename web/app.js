@@ -134,7 +134,7 @@ function paint(ids, tool, label) {
     if (tool === 'support' && old >= 0) continue; // painting the support keeps handles
     if (old !== label) { state.labels[v] = label; touched.push(v); }
   }
-  if (touched.length) { state.dirtyRegion = true; view.colour(state.labels, touched); }
+  if (touched.length) { state.dirtyRegion = true; view.colour(state.labels, touched); if (painting) strokeChanged(); }
 }
 
 function submitPick(event, paintIt) {
@@ -162,12 +162,27 @@ window.addEventListener('pointerup', () => {
   if (!painting) return;
   painting = false;
   orbit.enabled = true;
+  clearTimeout(pauseTimer);
   state.marks.strokeEnd = performance.now();
   task(async () => {
     await picks.idle();
     if (state.dirtyRegion) await sendRegion();
+    else if (regionSent) await regionSent.then(regionShown); // sent in a pause of the stroke
   });
 });
+
+// The region's work hides behind the brush: when a stroke pauses (the pointer held still for
+// PAUSE_MS), the region as painted so far goes to the server, which solves it while the user
+// looks; a later change sends it again, and the server stops the stale job for it. At mouse-up
+// nothing is left to send when nothing changed since.
+const PAUSE_MS = 250;
+let pauseTimer = 0, regionSent = null;
+function strokeChanged() {
+  clearTimeout(pauseTimer);
+  pauseTimer = setTimeout(() => {
+    if (painting && state.dirtyRegion) task(() => sendRegion({ inStroke: true }));
+  }, PAUSE_MS);
+}
 
 /// The painted region as the API takes it; handles are renumbered so that none is empty (the
 /// labels follow), and `free` counts the support's vertices outside every handle.
@@ -200,22 +215,26 @@ function regionLists() {
 }
 
 /// Sends the painted region when it can be solved; otherwise says what is missing. A refusal
-/// (a 4xx or the job's error) keeps the paint and shows the server's message.
-async function sendRegion({ keepGizmo = false } = {}) {
-  const started = performance.now();
+/// (a 4xx or the job's error) keeps the paint and shows the server's message. A region sent
+/// while the server solves an older one replaces it (the server stops the older job); only the
+/// newest send brings the page up to the result. inStroke: sent in a pause of a stroke (no
+/// hints, the tool stays); keepGizmo: a new k under the same region.
+let regionSeq = 0;
+async function sendRegion({ keepGizmo = false, inStroke = false } = {}) {
+  const started = performance.now(), seq = ++regionSeq;
   state.dirtyRegion = false;
   const { support, handles, free } = regionLists();
   showHandleButtons();
-  if (!handles.length) {
-    message(support.length ? 'Now paint a handle inside the support (tool "Handle", H).'
-                           : 'Paint a support (S), then a handle inside it (H).', 'hint');
+  if (!handles.length || !free) {
+    regionSent = null;
+    if (inStroke) return;
+    if (!handles.length)
+      message(support.length ? 'Now paint a handle inside the support (tool "Handle", H).'
+                             : 'Paint a support (S), then a handle inside it (H).', 'hint');
+    else message('The support has no free vertex: paint the support around the handle (tool "Support", S).', 'hint');
     return;
   }
-  if (!free) {
-    message('The support has no free vertex: paint the support around the handle (tool "Support", S).', 'hint');
-    return;
-  }
-  if (busy()) await settle();
+  if (busy() && state.status?.progress?.job !== 'region') await settle(); // a load: wait for it
   const steps = { started, lists: performance.now() };
   const posted = post('region', { support, handles, k: state.k });
   // While the request travels and the server solves: the normal plan of the region sent (its
@@ -223,34 +242,61 @@ async function sendRegion({ keepGizmo = false } = {}) {
   state.sentMovable = Uint32Array.from(support);
   view.setMovable(state.sentMovable);
   steps.planned = performance.now();
-  try {
-    panels.showProgress(await (await posted).json());
-  } catch (e) {
+  const outcome = (async () => {
+    try {
+      panels.showProgress(await (await posted).json());
+    } catch (e) {
+      return { failed: true };
+    }
+    steps.posted = performance.now();
+    const s = await settle();
+    steps.settled = performance.now();
+    return { s };
+  })();
+  // Resolves once the page holds the result (only the newest send brings the page up to it).
+  const sent = (async () => {
+    const result = { ...(await outcome), seq, steps, keepGizmo };
+    if (seq === regionSeq) await regionArrived(result);
+    return result;
+  })();
+  regionSent = sent;
+  const result = await sent;
+  if (!inStroke && !painting) regionShown(result);
+}
+
+/// Brings the page up to a region's result (or back to the region it had, on a refusal).
+async function regionArrived({ failed, s, keepGizmo }) {
+  if (failed || s.error) {
     state.sentMovable = null;
     view.setMovable(state.movable);
-    return;
-  }
-  steps.posted = performance.now();
-  const s = await settle();
-  steps.settled = performance.now();
-  if (s.error) {
-    state.sentMovable = null;
-    view.setMovable(state.movable);
-    state.status = s;
-    panels.showStats(s, state.frameMs);
+    if (s) {
+      state.status = s;
+      panels.showStats(s, state.frameMs);
+    }
     state.dirtyRegion = true;
     placeGizmo(true);
     return;
   }
   await sync(s, { labelsKnown: true, keepGizmo });
   state.sentMovable = null;
+}
+
+/// After the stroke: the manipulator on the region (the Orbit tool), and the marks of the
+/// benchmark.
+function regionShown({ failed, s, steps, keepGizmo, seq }) {
+  if (failed || s?.error || seq !== regionSeq || painting) return;
+  regionSent = null;
   state.marks.regionReady.push(performance.now());
-  for (const key of Object.keys(steps)) steps[key] -= state.marks.strokeEnd;
-  state.marks.regionSteps.push(steps);
-  if (!keepGizmo) {
-    setTool('orbit');
-    message('Region ready; the Orbit tool is on: drag the arrows to move the handle (S, H: paint again).', 'info');
+  const relative = { ...steps };
+  for (const key of Object.keys(relative)) relative[key] -= state.marks.strokeEnd;
+  state.marks.regionSteps.push(relative);
+  if (keepGizmo) {
+    placeGizmo(true);
+    return;
   }
+  setTool('orbit');
+  placeGizmo(); // on the handle of this region
+  message('Region ready; the Orbit tool is on: drag the arrows to move the handle (S, H: paint again).', 'info');
 }
 
 // ---- handles and the manipulator ----------------------------------------------------------------

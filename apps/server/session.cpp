@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <functional>
+#include <stop_token>
 #include <string_view>
 #include <utility>
 
@@ -64,6 +65,14 @@ struct Session::Impl {
   std::condition_variable idle;
   std::thread worker;
   bool busy = false;
+  // The running job's stop request, and the job queued behind it: a new region while a region
+  // job runs stops that job (set_region checks between its steps) and runs next.
+  std::stop_source stop;
+  std::function<void(std::stop_token)> pending;
+  // A bake kept for the next region job when a newer region stopped the job after its bake: the
+  // same editor under the same transforms bakes into the same shape.
+  std::shared_ptr<EditorBox> baked, baked_from;
+  std::vector<Transform> baked_transforms;
   std::string job;   // what the worker does ("load", "region")
   std::string phase; // its current phase
   int step = 0, steps = 0;
@@ -137,27 +146,111 @@ struct Session::Impl {
     const double within = n > 0 ? std::clamp(double(s) / n, 0.0, 1.0) : 0.0;
     fraction = span_begin + (span_end - span_begin) * (begin + (end - begin) * within);
   }
-  void run(std::string what, std::function<void()> work) {
-    if (busy) throw Busy(fmt::format("the session is busy ({}: {})", job, phase));
+  /// Runs `work` on the worker. While a region job runs, another region job stops it and is
+  /// queued behind it (replacing one queued already); any other overlap throws Busy. Call under
+  /// the lock.
+  void run(std::string what, std::function<void(std::stop_token)> work) {
+    if (busy) {
+      if (what == "region" && job == "region") {
+        stop.request_stop();
+        pending = std::move(work);
+        return;
+      }
+      throw Busy(fmt::format("the session is busy ({}: {})", job, phase));
+    }
     if (worker.joinable()) worker.join();
     busy = true;
     job = std::move(what);
+    begin_job();
+    worker = std::thread([this, work = std::move(work), token = stop.get_token()]() mutable {
+      for (;;) {
+        try {
+          work(token);
+        } catch (const Cancelled&) {
+          // A newer region stopped it: that one runs next.
+        } catch (const std::exception& e) {
+          std::lock_guard lock(mutex);
+          error = e.what();
+        }
+        std::lock_guard lock(mutex);
+        if (pending) {
+          work = std::move(pending);
+          pending = nullptr;
+          begin_job();
+          token = stop.get_token();
+          continue;
+        }
+        busy = false;
+        phase.clear();
+        idle.notify_all();
+        return;
+      }
+    });
+  }
+  /// A job's start: a fresh stop request, no progress, no error. Call under the lock.
+  void begin_job() {
+    stop = std::stop_source();
     phase = "starting";
     step = steps = 0;
     fraction = 0.0;
     error.clear();
-    worker = std::thread([this, work = std::move(work)] {
-      try {
-        work();
-      } catch (const std::exception& e) {
-        std::lock_guard lock(mutex);
-        error = e.what();
-      }
+  }
+  /// The editor that `current` under `moved_by` bakes into (the edited shape as a new input), or
+  /// the one a stopped job made for the same bake.
+  std::shared_ptr<EditorBox> bake_once(const std::shared_ptr<EditorBox>& current,
+                                       const std::vector<Transform>& moved_by) {
+    {
       std::lock_guard lock(mutex);
-      busy = false;
-      phase.clear();
-      idle.notify_all();
-    });
+      if (baked && baked_from == current && baked_transforms == moved_by) return baked;
+    }
+    const auto t0 = Clock::now();
+    Mesh result = current->editor.result();
+    auto next = std::make_shared<EditorBox>(Editor(std::move(result), editor_options()));
+    next->preprocess_ms = ms_since(t0);
+    std::lock_guard lock(mutex);
+    baked = next;
+    baked_from = current;
+    baked_transforms = moved_by;
+    return next;
+  }
+  /// A region job: the bake when a handle moved, the region prepared, then installed unless a
+  /// newer region stopped the job (that one runs next and installs its own): a stopped job
+  /// changes nothing.
+  void region_job(const RegionKey& key, bool bake, bool new_k,
+                  const std::shared_ptr<EditorBox>& current,
+                  const std::vector<Transform>& moved_by, const std::stop_token& token) {
+    {
+      std::lock_guard lock(mutex);
+      span_begin = 0.0;
+      span_end = bake ? 0.85 : 0.0;
+    }
+    const std::shared_ptr<EditorBox> next = bake ? bake_once(current, moved_by) : current;
+    {
+      std::lock_guard lock(mutex);
+      report("set_region", 0, 1);
+    }
+    // On a copy of the key: a failure leaves the session as it was.
+    const KHarmonicOptions system{key.k, next->editor.options().system.areas};
+    next->editor.set_system(system);
+    Editor::Prepared prepared = next->editor.prepare_region(key.support, key.handles, token);
+    std::lock_guard lock(mutex);
+    if (token.stop_requested()) return; // stale: the newer region is queued
+    next->editor.install_region(std::move(prepared));
+    next->region = key;
+    box = next;
+    region = key;
+    baked.reset();
+    baked_from.reset();
+    ++region_id;
+    if (new_k) {
+      for (std::size_t j = 0; j < moved_by.size(); ++j)
+        box->editor.set_transform(static_cast<int>(j), moved_by[j]);
+      shape->set_positions(box->editor.positions());
+      ++positions_id;
+    } else {
+      transforms.assign(key.handles.size(), identity_transform());
+    }
+    push_snapshot();
   }
   EditorOptions editor_options() {
     EditorOptions o = options.editor;
@@ -191,7 +284,7 @@ void Session::wait_for(std::chrono::milliseconds timeout) {
 void Session::start_load(std::string bytes, std::string name) {
   std::lock_guard lock(impl_->mutex);
   const MeshFormat format = format_from_path(name); // IoError for an unknown extension at once
-  impl_->run("load", [this, bytes = std::move(bytes), name, format] {
+  impl_->run("load", [this, bytes = std::move(bytes), name, format](std::stop_token) {
     Impl& m = *impl_;
     const auto t0 = Clock::now();
     {
@@ -221,7 +314,7 @@ void Session::start_load(std::string bytes, std::string name) {
 void Session::start_region(std::vector<int> support, std::vector<std::vector<int>> handles, int k) {
   std::lock_guard lock(impl_->mutex);
   Impl& m = *impl_;
-  m.require_ready();
+  if (!(m.busy && m.job == "region")) m.require_ready(); // a region job: stopped and followed
   if (k < 1 || k > 3) throw InvalidArgument(fmt::format("k = {} is not 1, 2 or 3", k));
   const auto n = static_cast<int>(m.box->editor.input().n_vertices());
   for (const int v : support)
@@ -241,45 +334,10 @@ void Session::start_region(std::vector<int> support, std::vector<std::vector<int
   const bool new_k = m.region && m.region->support == key.support &&
                      m.region->handles == key.handles && m.region->k != key.k;
   const bool bake = !new_k && !is_identity(m.transforms);
-  m.span_begin = 0.0;
-  m.span_end = bake ? 0.85 : 0.0;
-  m.run("region",
-        [this, key = std::move(key), bake, new_k, current = m.box, transforms = m.transforms] {
-          Impl& s = *impl_;
-          std::shared_ptr<EditorBox> box = current;
-          if (bake) {
-            // The edited shape becomes the next input: a new base, remeshed.
-            const auto t0 = Clock::now();
-            Mesh result = current->editor.result();
-            box = std::make_shared<EditorBox>(Editor(std::move(result), s.editor_options()));
-            box->preprocess_ms = ms_since(t0);
-          }
-          {
-            std::lock_guard guard(s.mutex);
-            s.report("set_region", 0, 1);
-          }
-          // On a copy of the key: a failure leaves the session as it was.
-          box->editor.set_system({key.k, box->editor.options().system.areas});
-          box->editor.set_region(key.support, key.handles);
-          box->region = key;
-          std::optional<Eigen::MatrixXd> moved;
-          if (new_k) {
-            for (std::size_t j = 0; j < transforms.size(); ++j)
-              box->editor.set_transform(static_cast<int>(j), transforms[j]);
-            moved = box->editor.positions();
-          }
-          std::lock_guard guard(s.mutex);
-          s.box = box;
-          s.region = key;
-          ++s.region_id;
-          if (moved) {
-            s.shape->set_positions(*moved);
-            ++s.positions_id;
-          } else {
-            s.transforms.assign(key.handles.size(), identity_transform());
-          }
-          s.push_snapshot();
-        });
+  m.run("region", [this, key = std::move(key), bake, new_k, current = m.box,
+                   moved_by = m.transforms](std::stop_token token) {
+    impl_->region_job(key, bake, new_k, current, moved_by, token);
+  });
 }
 
 std::vector<float> Session::set_transform(int handle, const Transform& transform,
@@ -356,7 +414,7 @@ nlohmann::json Session::status() const {
                {"area_rel_mad", r.base_quality.mixed_area.rel_mad},
                {"min_angle_deg", r.base_quality.angles.min_deg},
                {"symmetry_defect", r.base_symmetry_defect}};
-  j["k"] = m.box->editor.options().system.k;
+  j["k"] = m.region ? m.region->k : m.box->editor.options().system.k;
   j["frame_ms"] = m.last_frame_ms;
   if (m.region) {
     j["region"] = {{"support", m.region->support.size()},

@@ -183,6 +183,48 @@ async function manipulatorRules(page, log) {
         `after New handle the manipulator is hidden (${shown}) and its old place sends no move (${sent}; "${box.hidden ? '' : box.text}")`);
 }
 
+/// The region's work hides behind the brush: a stroke that pauses sends the region painted so
+/// far; painting on after it sends the region again (the server stops the stale job) and the
+/// server ends with the region as painted at mouse-up; a pause with nothing painted after it
+/// leaves nothing to send at mouse-up.
+async function regionInPause(page, log, c, site) {
+  await page.keyboard.press('s');
+  await remora(page, 'setRadius', 0.8 * site.supportRadius);
+  const start = await remora(page, 'project', await remora(page, 'nearest', ...site.support));
+  // A stroke with a pause in the middle, then more paint elsewhere.
+  let from = log.length;
+  await page.mouse.move(start.x, start.y);
+  await page.mouse.down();
+  for (let i = 1; i <= 4; ++i) await page.mouse.move(start.x + 2 * i, start.y);
+  await page.waitForTimeout(900);
+  const inPause = since(log, from, /POST region/).length;
+  for (let i = 1; i <= 6; ++i) await page.mouse.move(start.x + 8, start.y + 4 * i);
+  await page.mouse.up();
+  await ready(page, 120000);
+  const sent = since(log, from, /POST region/);
+  const labels = await remora(page, 'labels');
+  const region = await c.json('region');
+  const painted = labels.flatMap((l, v) => (l !== -2 ? [v] : []));
+  check(inPause >= 1 && sent.length >= 2 && JSON.stringify(region?.support) === JSON.stringify(painted),
+        `a stroke's pause sends the region (${inPause} during it, ${sent.length} in all) and the server ` +
+        `ends with the region painted at mouse-up (${region?.support.length} = ${painted.length} vertices)`);
+  // A pause, then mouse-up without more paint: nothing left to send, the manipulator comes.
+  await page.keyboard.press('s');
+  from = log.length;
+  await page.mouse.move(start.x - 6, start.y - 6);
+  await page.mouse.down();
+  for (let i = 1; i <= 3; ++i) await page.mouse.move(start.x - 6 - 2 * i, start.y - 6);
+  await page.waitForTimeout(900);
+  await ready(page, 120000).catch(() => {});
+  const before = since(log, from, /POST region/).length;
+  await page.mouse.up();
+  await ready(page, 120000);
+  const after = since(log, from, /POST region/).length;
+  check(before >= 1 && after === before && await activeTool(page) === 'orbit' &&
+        (await remora(page, 'shown')).manipulator,
+        `a pause then mouse-up sends nothing more (${before} then ${after}) and shows the manipulator`);
+}
+
 export const bugChecks = {
   async beforeRegion(page, log, c, site) {
     await handleWithoutSupport(page, log, site);
@@ -198,6 +240,7 @@ export const bugChecks = {
     await scaleClamp(page, log);
     await exportName(page);
     await manipulatorRules(page, log);
+    await regionInPause(page, log, c, site);
   },
 };
 

@@ -49,9 +49,11 @@ DetailMode parse_detail_mode(const std::string& name) {
 
 // ---- the editor ------------------------------------------------------------------------------
 
-namespace {
-
-struct RegionState {
+/// A region of the editor: its labels, basis functions, details and the frame's state; with the
+/// report it was made with (set_region's figures) and the editor that made it.
+struct Editor::Prepared::State {
+  const void* owner = nullptr;
+  EditReport report;
   std::vector<int> input_label; // per O vertex: kFixed, kFree or handle j
   std::vector<int> base_label;  // per B vertex
   int handles = 0;
@@ -72,7 +74,7 @@ struct RegionState {
   bool dirty = true;
 };
 
-} // namespace
+using RegionState = Editor::Prepared::State;
 
 struct Editor::Impl {
   EditorOptions options;
@@ -467,33 +469,58 @@ void Editor::Impl::find_affected(RegionState& r) const {
   r.affected = plan_normals(topology, vertices);
 }
 
-void Editor::set_region(const std::vector<int>& support,
-                        const std::vector<std::vector<int>>& handles, const std::stop_token& stop) {
+Editor::Prepared::Prepared() = default;
+Editor::Prepared::Prepared(Prepared&&) noexcept = default;
+Editor::Prepared& Editor::Prepared::operator=(Prepared&&) noexcept = default;
+Editor::Prepared::~Prepared() = default;
+
+Editor::Prepared Editor::prepare_region(const std::vector<int>& support,
+                                        const std::vector<std::vector<int>>& handles,
+                                        const std::stop_token& stop) {
   Impl& m = *impl_;
   const auto t_start = Clock::now();
   const auto check = [&] {
     if (stop.stop_requested())
       throw Cancelled("set_region was cancelled; the previous region stays in place");
   };
-  EditReport out = m.report;
   std::unique_ptr<RegionState> state = m.paint(support, handles);
   RegionState& r = *state;
+  r.owner = impl_.get();
+  r.report = m.report;
   m.map_to_base(r);
-  m.report_region(r, out);
+  m.report_region(r, r.report);
   check();
-  m.solve_basis(r, out, stop);
+  m.solve_basis(r, r.report, stop);
   check();
   m.find_affected(r);
-  m.encode_details(r, out, stop);
+  m.encode_details(r, r.report, stop);
   check();
   r.transforms.assign(static_cast<std::size_t>(r.handles), identity_transform());
   r.current_base = r.rest;
   r.current_normals = r.rest_normals;
   r.current_positions = m.input_positions;
   r.dirty = true;
-  out.milliseconds["set_region"] = ms_since(t_start);
-  m.region = std::move(state);
-  m.report = std::move(out);
+  r.report.milliseconds["set_region"] = ms_since(t_start);
+  Prepared prepared;
+  prepared.state_ = std::move(state);
+  return prepared;
+}
+
+void Editor::install_region(Prepared&& prepared) {
+  if (!prepared.state_ || prepared.state_->owner != impl_.get())
+    throw InvalidArgument("install_region: the region was not prepared by this editor (or was "
+                          "installed already)");
+  // The report's region figures and set_region's times; the rest stays the editor's.
+  EditReport& r = prepared.state_->report;
+  for (const auto& [key, ms] : impl_->report.milliseconds)
+    if (key.rfind("frame", 0) == 0) r.milliseconds[key] = ms;
+  impl_->report = std::move(r);
+  impl_->region = std::move(prepared.state_);
+}
+
+void Editor::set_region(const std::vector<int>& support,
+                        const std::vector<std::vector<int>>& handles, const std::stop_token& stop) {
+  install_region(prepare_region(support, handles, stop));
 }
 
 namespace {

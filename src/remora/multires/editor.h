@@ -137,6 +137,28 @@ public:
   void set_region(const std::vector<int>& support, const std::vector<std::vector<int>>& handles,
                   const std::stop_token& stop = {});
 
+  /// set_region() in two halves: prepare_region() does the work (it may throw as set_region()
+  /// does) and changes nothing the editor shows; install_region() makes the prepared region the
+  /// current one, at no cost. A caller can thus drop a region that a newer request made stale.
+  /// install_region() throws InvalidArgument for a region another editor prepared, or one
+  /// installed already.
+  class Prepared {
+  public:
+    Prepared();
+    Prepared(Prepared&&) noexcept;
+    Prepared& operator=(Prepared&&) noexcept;
+    ~Prepared();
+    struct State;
+
+  private:
+    friend class Editor;
+    std::unique_ptr<State> state_;
+  };
+  Prepared prepare_region(const std::vector<int>& support,
+                          const std::vector<std::vector<int>>& handles,
+                          const std::stop_token& stop = {});
+  void install_region(Prepared&& prepared);
+
   int handle_count() const;
   /// The vertices of O that can move under the current region (the support, handles included),
   /// in increasing order; empty before set_region().
