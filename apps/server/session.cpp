@@ -217,8 +217,8 @@ struct Session::Impl {
   /// newer region stopped the job (that one runs next and installs its own): a stopped job
   /// changes nothing.
   void region_job(const RegionKey& key, bool bake, bool new_k,
-                  const std::shared_ptr<EditorBox>& current,
-                  const std::vector<Transform>& moved_by, const std::stop_token& token) {
+                  const std::shared_ptr<EditorBox>& current, const std::vector<Transform>& moved_by,
+                  const std::stop_token& token) {
     {
       std::lock_guard lock(mutex);
       span_begin = 0.0;
