@@ -63,12 +63,11 @@ struct Editor::Prepared::State {
   std::vector<Eigen::Vector3d> handle_centers;
   Eigen::MatrixXd rest;         // B0
   Eigen::MatrixXd rest_normals; // of B0
-  std::vector<int> encoded;     // O vertices, in the order of `details`
-  std::vector<PhongDetail> details;
-  std::vector<Eigen::Vector3d> rest_offsets; // DetailMode::Displacement: p − b on B0
-  NormalPlan affected;                       // B vertices whose normal can change, and their faces
+  std::vector<int> encoded;     // O vertices with a detail, in increasing order
+  FrameDetails details;         // their details, decoded into the rows `encoded`
+  NormalPlan affected;          // B vertices whose normal can change, and their faces
   std::vector<Transform> transforms;
-  RowPoints current_base, current_normals; // a vertex's x, y, z together: the frame's reads
+  FrameRows frame; // B under the transforms: positions and normals
   Eigen::MatrixXd current_positions;
   std::vector<double> face_normals; // update_normals()'s scratch
   bool dirty = true;
@@ -440,18 +439,21 @@ void Editor::Impl::encode_details(RegionState& r, EditReport& out,
   for (std::size_t e = 0; e < r.encoded.size(); ++e)
     points.row(static_cast<Eigen::Index>(e)) = input_positions.row(r.encoded[e]);
   if (stop.stop_requested()) return;
-  r.details = encode_phong(topology, r.rest, r.rest_normals, points, starts, options.phong,
-                           &out.phong, options.threads);
+  const std::vector<PhongDetail> details = encode_phong(
+      topology, r.rest, r.rest_normals, points, starts, options.phong, &out.phong, options.threads);
+  std::vector<Eigen::Vector3d> rest_offsets; // DetailMode::Displacement: p − b on B0
   if (options.details == DetailMode::Displacement) {
-    r.rest_offsets.resize(r.details.size());
-    for (std::size_t e = 0; e < r.details.size(); ++e) {
-      PhongDetail foot = r.details[e];
+    rest_offsets.resize(details.size());
+    for (std::size_t e = 0; e < details.size(); ++e) {
+      PhongDetail foot = details[e];
       foot.offset = 0.0;
       foot.residual = false;
-      r.rest_offsets[e] = points.row(static_cast<Eigen::Index>(e)).transpose() -
-                          decode_phong(topology, r.rest, r.rest_normals, foot);
+      rest_offsets[e] = points.row(static_cast<Eigen::Index>(e)).transpose() -
+                        decode_phong(topology, r.rest, r.rest_normals, foot);
     }
   }
+  r.details =
+      frame_details(details, r.encoded, options.details == DetailMode::Normal, rest_offsets);
   out.milliseconds["encode"] = ms_since(t0);
 }
 
@@ -496,8 +498,7 @@ Editor::Prepared Editor::prepare_region(const std::vector<int>& support,
   m.encode_details(r, r.report, stop);
   check();
   r.transforms.assign(static_cast<std::size_t>(r.handles), identity_transform());
-  r.current_base = r.rest;
-  r.current_normals = r.rest_normals;
+  r.frame = frame_rows(r.rest, r.rest_normals);
   r.current_positions = m.input_positions;
   r.dirty = true;
   r.report.milliseconds["set_region"] = ms_since(t_start);
@@ -588,39 +589,20 @@ void Editor::Impl::update() {
   for (int j = 0; j < r.handles; ++j)
     coefficients.block<4, 3>(3 + 4 * j, 0) = r.transforms[static_cast<std::size_t>(j)].transpose();
   const int threads = options.threads;
-  blend_basis(r.basis, coefficients, r.free_vertices, r.current_base, threads);
+  blend_basis(r.basis, coefficients, r.free_vertices, r.frame, threads);
   for (int j = 0; j < r.handles; ++j) {
     const Transform& t = r.transforms[static_cast<std::size_t>(j)];
     for (const int v : r.handle_base[static_cast<std::size_t>(j)])
-      r.current_base.row(v) =
+      r.frame.row(v).head<3>() =
           (t.leftCols<3>() * base_rest.row(v).transpose() + t.col(3)).transpose();
   }
   const auto t_normals = Clock::now();
   report.milliseconds["frame blend"] = ms_since(t0);
   // Normals where they can change.
-  update_normals(topology, r.current_base, r.affected, r.current_normals, r.face_normals, threads);
+  update_normals(topology, r.affected, r.frame, r.face_normals, threads);
   const auto t_decode = Clock::now();
   report.milliseconds["frame normals"] = ms_since(t_normals);
-  // Decode.
-  parallel_for(r.encoded.size(), threads, [&](std::size_t e) {
-    const PhongDetail& d = r.details[e];
-    Eigen::Vector3d p;
-    switch (options.details) {
-    case DetailMode::Normal:
-      p = decode_phong(topology, r.current_base, r.current_normals, d);
-      break;
-    case DetailMode::Displacement:
-    case DetailMode::None: {
-      PhongDetail on_base = d;
-      on_base.offset = 0.0;
-      on_base.residual = false;
-      p = decode_phong(topology, r.current_base, r.current_normals, on_base);
-      if (options.details == DetailMode::Displacement) p += r.rest_offsets[e];
-      break;
-    }
-    }
-    r.current_positions.row(r.encoded[e]) = p.transpose();
-  });
+  decode_details(topology, r.frame, r.details, r.current_positions, threads);
   r.dirty = false;
   report.milliseconds["frame decode"] = ms_since(t_decode);
   report.milliseconds["frame"] = ms_since(t0);
@@ -648,7 +630,7 @@ const Mesh& Editor::base() const {
 
 Eigen::MatrixXd Editor::base_positions() {
   impl_->update();
-  return impl_->region->current_base;
+  return impl_->region->frame.leftCols<3>();
 }
 
 Eigen::MatrixXd Editor::low_pass(const Eigen::MatrixXd& values) {

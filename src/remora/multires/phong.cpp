@@ -8,6 +8,7 @@
 
 #include "remora/common/error.h"
 #include "remora/common/parallel.h"
+#include "remora/multires/phong_decode.h"
 
 namespace remora {
 namespace {
@@ -34,34 +35,13 @@ Corners corners(const TriangleTopology& t, const Points& positions, const Points
   return c;
 }
 
-/// The face's frame: edge 0-1, normal × edge, normal. False for a face without area.
 bool face_frame(const Corners& c, V3& t1, V3& t2, V3& nf) {
-  const V3 e1 = c.x[1] - c.x[0];
-  const V3 cross = e1.cross(c.x[2] - c.x[0]);
-  const double len = e1.norm(), area2 = cross.norm();
-  if (!(area2 > 1e-14 * std::max(len * len, (c.x[2] - c.x[0]).squaredNorm())) || !(len > 0.0))
-    return false;
-  t1 = e1 / len;
-  nf = cross / area2;
-  t2 = nf.cross(t1);
-  return true;
+  return phong_detail::face_frame(c.x, t1, t2, nf);
 }
 
 V3 decode(const Corners& c, const PhongDetail& d) {
-  const auto& a = d.base.bary;
-  const V3 b = a[0] * c.x[0] + a[1] * c.x[1] + a[2] * c.x[2];
-  V3 n = a[0] * c.n[0] + a[1] * c.n[1] + a[2] * c.n[2];
-  const double len = n.norm();
-  V3 p = b;
-  if (len > 0.0) p += (d.offset / len) * n;
-  if (d.residual) {
-    V3 t1, t2, nf;
-    if (face_frame(c, t1, t2, nf))
-      p += d.frame[0] * t1 + d.frame[1] * t2 + d.frame[2] * nf;
-    else
-      p += V3(d.frame[0], d.frame[1], d.frame[2]);
-  }
-  return p;
+  return phong_detail::phong_point(c.x, c.n, d.base.bary, d.offset,
+                                   d.residual ? &d.frame : nullptr);
 }
 
 struct FaceSolution {
