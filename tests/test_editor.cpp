@@ -363,6 +363,41 @@ TEST(Editor, AFailedOrCancelledRegionChangesNothing) {
   EXPECT_EQ(editor.positions(), moved);
 }
 
+// Setting one of the last regions again (an undo) installs it as it was: no work, the same
+// positions bit for bit, transforms back at the identity; a region further back is solved again,
+// with the same result.
+TEST(Editor, ARecentRegionSetAgainIsReusedBitForBit) {
+  const Mesh mesh = bumpy_sphere(3);
+  Editor editor(mesh);
+  const Vec3 tops[3] = {Vec3(0, 0, 1), Vec3(1, 0, 0), Vec3(0, 1, 0)};
+  std::vector<Eigen::MatrixXd> moved;
+  const Transform lift = translation({0.0, 0.1, 0.2});
+  for (const Vec3& top : tops) {
+    editor.set_region(sphere_ids(mesh, top, 0.8), {sphere_ids(mesh, top, 0.2)});
+    EXPECT_FALSE(editor.report().region_reused);
+    editor.set_transform(0, lift);
+    moved.push_back(editor.positions());
+  }
+  // The second region again: from the recent ones.
+  editor.set_region(sphere_ids(mesh, tops[1], 0.8), {sphere_ids(mesh, tops[1], 0.2)});
+  EXPECT_TRUE(editor.report().region_reused);
+  EXPECT_EQ(editor.transform(0), identity_transform());
+  EXPECT_LT(max_row_distance(editor.positions(), positions_matrix(mesh)),
+            1e-10 * bounding_box_diagonal(mesh));
+  editor.set_transform(0, lift);
+  EXPECT_EQ(editor.positions(), moved[1]);
+  // Another k is another region.
+  editor.set_system({1, AreaWeights::Mean});
+  editor.set_region(sphere_ids(mesh, tops[2], 0.8), {sphere_ids(mesh, tops[2], 0.2)});
+  EXPECT_FALSE(editor.report().region_reused);
+  // The first, pushed out of the recent ones, is solved again: the same doubles.
+  editor.set_system({2, AreaWeights::Mean});
+  editor.set_region(sphere_ids(mesh, tops[0], 0.8), {sphere_ids(mesh, tops[0], 0.2)});
+  EXPECT_FALSE(editor.report().region_reused);
+  editor.set_transform(0, lift);
+  EXPECT_EQ(editor.positions(), moved[0]);
+}
+
 TEST(Editor, SeveralHandlesAndTheUnsymmetricSystem) {
   const Mesh mesh = bumpy_sphere(3);
   EditorOptions options;

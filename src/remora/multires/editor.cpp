@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <deque>
 #include <optional>
 #include <utility>
 
@@ -54,6 +55,10 @@ DetailMode parse_detail_mode(const std::string& name) {
 struct Editor::Prepared::State {
   const void* owner = nullptr;
   EditReport report;
+  // What it was prepared from (set_region's arguments and the system), to find it again.
+  std::vector<int> support;
+  std::vector<std::vector<int>> handle_ids;
+  KHarmonicOptions system;
   std::vector<int> input_label; // per O vertex: kFixed, kFree or handle j
   std::vector<int> base_label;  // per B vertex
   int handles = 0;
@@ -91,6 +96,10 @@ struct Editor::Impl {
   std::unique_ptr<MultigridSolver> multigrid;
   EditReport report;
   std::unique_ptr<RegionState> region;
+  // The regions installed before the current one, the latest first: set_region() of one of them
+  // again (an undo) installs it as it was, without the work.
+  std::deque<std::unique_ptr<RegionState>> recent;
+  static constexpr std::size_t kRecentRegions = 2;
 
   void progress(std::string_view phase, int step, int steps) const {
     if (options.progress) options.progress(phase, step, steps);
@@ -485,10 +494,29 @@ Editor::Prepared Editor::prepare_region(const std::vector<int>& support,
     if (stop.stop_requested())
       throw Cancelled("set_region was cancelled; the previous region stays in place");
   };
+  for (auto it = m.recent.begin(); it != m.recent.end(); ++it) {
+    RegionState& old = **it;
+    if (old.support != support || old.handle_ids != handles || old.system.k != m.options.system.k ||
+        old.system.areas != m.options.system.areas)
+      continue;
+    Prepared prepared;
+    prepared.state_ = std::move(*it);
+    m.recent.erase(it);
+    RegionState& r = *prepared.state_;
+    r.transforms.assign(static_cast<std::size_t>(r.handles), identity_transform());
+    r.dirty = true;
+    r.report.region_reused = true;
+    r.report.milliseconds["set_region"] = ms_since(t_start);
+    return prepared;
+  }
   std::unique_ptr<RegionState> state = m.paint(support, handles);
   RegionState& r = *state;
   r.owner = impl_.get();
+  r.support = support;
+  r.handle_ids = handles;
+  r.system = m.options.system;
   r.report = m.report;
+  r.report.region_reused = false;
   m.map_to_base(r);
   m.report_region(r, r.report);
   check();
@@ -499,6 +527,7 @@ Editor::Prepared Editor::prepare_region(const std::vector<int>& support,
   check();
   r.transforms.assign(static_cast<std::size_t>(r.handles), identity_transform());
   r.frame = frame_rows(r.rest, r.rest_normals);
+  r.rest_normals.resize(0, 0); // in the frame now
   r.current_positions = m.input_positions;
   r.dirty = true;
   r.report.milliseconds["set_region"] = ms_since(t_start);
@@ -516,6 +545,10 @@ void Editor::install_region(Prepared&& prepared) {
   for (const auto& [key, ms] : impl_->report.milliseconds)
     if (key.rfind("frame", 0) == 0) r.milliseconds[key] = ms;
   impl_->report = std::move(r);
+  if (impl_->region) {
+    impl_->recent.push_front(std::move(impl_->region));
+    if (impl_->recent.size() > Impl::kRecentRegions) impl_->recent.pop_back();
+  }
   impl_->region = std::move(prepared.state_);
 }
 
@@ -671,7 +704,8 @@ nlohmann::json to_json(const EditReport& r) {
                  {"free_base_vertices", r.free_base_vertices},
                  {"constrained_base_vertices", r.constrained_base_vertices},
                  {"handle_base_vertices", r.handle_base_vertices},
-                 {"negative_cotan_weights_in_support", r.negative_weights_in_support}};
+                 {"negative_cotan_weights_in_support", r.negative_weights_in_support},
+                 {"reused", r.region_reused}};
   j["solver"] = {{"name", r.solver},
                  {"solves", r.solves},
                  {"iterations", r.solver_stats.iterations},

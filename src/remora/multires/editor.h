@@ -106,6 +106,9 @@ struct EditReport {
   /// Edges of the system's mesh with a free end whose cotan weight is negative (none on a good
   /// remesh; many on a scan's own connectivity).
   std::size_t negative_weights_in_support = 0;
+  /// The region was one of the last ones installed, set again (an undo): installed as it was,
+  /// without the work; the other figures are those of its first set_region().
+  bool region_reused = false;
   std::string solver;
   SolverStats solver_stats;
   int solves = 0; ///< right-hand sides solved (3 + 4h)
@@ -133,7 +136,9 @@ public:
   /// free base vertex, or a support component (on the base) with no constrained vertex; throws
   /// NumericalError when the solver fails, and Cancelled when `stop` is triggered (checked between
   /// the steps; a factorization runs to its end). On a throw the previous region and the report
-  /// stay as they were.
+  /// stay as they were. One of the last two regions installed before this one, set again with
+  /// the same ids and system (an undo), is installed as it was, without the work: the same
+  /// positions bit for bit.
   void set_region(const std::vector<int>& support, const std::vector<std::vector<int>>& handles,
                   const std::stop_token& stop = {});
 
