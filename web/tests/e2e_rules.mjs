@@ -110,20 +110,31 @@ async function kAfterMove(page, c, edit) {
 }
 
 /// While a job runs (a stroke after a move: the shape is baked into a new base) the progress shows
-/// "phase — NN %" and undo, redo and export are disabled.
+/// "phase — NN %" and undo, redo and export are disabled. The bake may start in a pause of the
+/// stroke and end before mouse-up, so the page is watched from the stroke's start.
 async function busyButtons(page, site) {
   await page.keyboard.press('s');
   await remora(page, 'setRadius', 1.4 * site.supportRadius);
+  await page.evaluate(() => {
+    const seen = (window.__busySeen = []);
+    const look = () => {
+      if (document.getElementById('progress').hidden) return;
+      seen.push({
+        text: document.getElementById('progress-text').textContent,
+        disabled: ['#undo', '#redo', '#export button, #panel a.button']
+          .map((q) => [...document.querySelectorAll(q)].every((b) => b.disabled)),
+      });
+    };
+    window.__busyObserver = new MutationObserver(look);
+    window.__busyObserver.observe(document.getElementById('panel'), { attributes: true, childList: true, subtree: true, characterData: true });
+  });
   await stroke(page, site.supportVertex);
-  await page.waitForFunction(() => !document.getElementById('progress').hidden || window.remora.ready(),
-                             null, { timeout: 60000, polling: 20 });
-  const during = await page.evaluate(() => ({
-    progress: document.getElementById('progress').hidden ? null : document.getElementById('progress-text').textContent,
-    disabled: ['#undo', '#redo', '#export button, #panel a.button'].map((q) => [...document.querySelectorAll(q)].every((b) => b.disabled)),
-  }));
-  check(during.progress && /\d+ %/.test(during.progress) && during.disabled.every(Boolean),
-        `while a bake runs: "${during.progress}", undo, redo and export disabled (${during.disabled})`);
   await ready(page, 180000);
+  const seen = await page.evaluate(() => { window.__busyObserver.disconnect(); return window.__busySeen; });
+  const during = seen.find((x) => /\d+ %/.test(x.text)) ?? { text: null, disabled: [] };
+  const allDisabled = seen.filter((x) => /\d+ %/.test(x.text)).every((x) => x.disabled.every(Boolean));
+  check(during.text && allDisabled && during.disabled.length === 3,
+        `while a bake runs: "${during.text}", undo, redo and export disabled (${during.disabled}; ${seen.length} views of the progress)`);
   await page.keyboard.press('o');
 }
 
@@ -190,7 +201,19 @@ async function manipulatorRules(page, log) {
 async function regionInPause(page, log, c, site) {
   await page.keyboard.press('s');
   await remora(page, 'setRadius', 0.8 * site.supportRadius);
-  const start = await remora(page, 'project', await remora(page, 'nearest', ...site.support));
+  // Start on the unpainted vertex nearest the support's centre, so that the stroke changes the
+  // region whatever earlier strokes painted.
+  const startVertex = await page.evaluate((c) => {
+    const p = window.remora.positionsHeld(), labels = window.remora.labels();
+    let best = -1, bestD = Infinity;
+    for (let v = 0; v < labels.length; ++v) {
+      if (labels[v] !== -2) continue;
+      const d = (p[3 * v] - c[0]) ** 2 + (p[3 * v + 1] - c[1]) ** 2 + (p[3 * v + 2] - c[2]) ** 2;
+      if (d < bestD) { bestD = d; best = v; }
+    }
+    return best;
+  }, site.support);
+  const start = await remora(page, 'project', startVertex);
   // A stroke with a pause in the middle, then more paint elsewhere.
   let from = log.length;
   await page.mouse.move(start.x, start.y);
