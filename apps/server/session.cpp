@@ -12,6 +12,7 @@
 #include "remora/geometry/quality.h"
 #include "remora/linalg/kharmonic.h"
 #include "remora/mesh/io.h"
+#include "remora/multires/bake.h"
 
 namespace remora::server {
 
@@ -30,6 +31,7 @@ struct EditorBox {
   Editor editor;
   std::optional<RegionKey> region;
   double preprocess_ms = 0.0;
+  std::optional<BakeReport> bake; ///< how a bake made it (none for a load)
 };
 
 struct Snapshot {
@@ -49,6 +51,7 @@ bool is_identity(const std::vector<Transform>& transforms) {
 /// the remesh); the bar moves forward, it does not promise a time.
 std::pair<double, double> preprocess_share(std::string_view phase) {
   if (phase == "reading") return {0.0, 0.05};
+  if (phase == "bake") return {0.0, 1.0}; // a local bake; a full one reports the phases below
   if (phase == "base surface") return {0.05, 0.2};
   if (phase == "remesh: remesh") return {0.2, 0.6};
   if (phase == "remesh: equalize") return {0.6, 0.9};
@@ -248,11 +251,13 @@ void Session::start_region(std::vector<int> support, std::vector<std::vector<int
           Impl& s = *impl_;
           std::shared_ptr<EditorBox> box = current;
           if (bake) {
-            // The edited shape becomes the next input: a new base, remeshed.
+            // The edited shape becomes the next input: filtered and remeshed again where the
+            // edit changed it (multires/bake.h), or in full where that cannot work.
             const auto t0 = Clock::now();
-            Mesh result = current->editor.result();
-            box = std::make_shared<EditorBox>(Editor(std::move(result), s.editor_options()));
+            BakeResult baked = remora::bake(current->editor);
+            box = std::make_shared<EditorBox>(std::move(baked.editor));
             box->preprocess_ms = ms_since(t0);
+            box->bake = std::move(baked.report);
           }
           {
             std::lock_guard guard(s.mutex);
@@ -356,6 +361,10 @@ nlohmann::json Session::status() const {
                {"area_rel_mad", r.base_quality.mixed_area.rel_mad},
                {"min_angle_deg", r.base_quality.angles.min_deg},
                {"symmetry_defect", r.base_symmetry_defect}};
+  if (m.box->bake)
+    j["base"]["bake"] = {{"local", m.box->bake->local},
+                         {"fallback", m.box->bake->fallback},
+                         {"milliseconds", m.box->bake->milliseconds}};
   j["k"] = m.box->editor.options().system.k;
   j["frame_ms"] = m.last_frame_ms;
   if (m.region) {
