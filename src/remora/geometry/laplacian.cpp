@@ -60,6 +60,10 @@ std::vector<double> edge_weights(const Mesh& mesh) {
 
 } // namespace
 
+std::vector<double> cotan_edge_weights(const Mesh& mesh) {
+  return edge_weights(mesh);
+}
+
 double cotan_weight(const Mesh& mesh, EdgeHandle e) {
   // In face order, as edge_weights() adds them.
   FaceHandle faces[2] = {mesh.face_handle(mesh.halfedge_handle(e, 0)),

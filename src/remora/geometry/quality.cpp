@@ -103,6 +103,8 @@ EdgeLengthFigures edge_length_figures(const Mesh& mesh) {
   return figures;
 }
 
+} // namespace
+
 VertexAreaFigures vertex_area_figures(const Eigen::VectorXd& areas,
                                       const std::vector<VertexHandle>& interior) {
   VertexAreaFigures figures;
@@ -123,6 +125,8 @@ VertexAreaFigures vertex_area_figures(const Eigen::VectorXd& areas,
   figures.rel_mad = absolute / n / figures.mean;
   return figures;
 }
+
+namespace {
 
 nlohmann::json histogram_json(const std::map<int, std::size_t>& histogram) {
   nlohmann::json array = nlohmann::json::array();
@@ -152,21 +156,7 @@ double percent_edges_within(const Mesh& mesh, double lo, double hi) {
   return edges > 0 ? 100.0 * static_cast<double>(within) / static_cast<double>(edges) : 0.0;
 }
 
-MeshQuality mesh_quality(const Mesh& mesh, const QualityOptions& options) {
-  MeshQuality q;
-
-  // Counts and topology.
-  q.vertices = count(mesh.vertices());
-  q.faces = count(mesh.faces());
-  q.edges = count(mesh.edges());
-  if (options.topology) {
-    q.boundary_loops = boundary_loops(mesh).size();
-    q.component_topology = component_topology(mesh);
-    q.components = q.component_topology.size();
-  }
-
-  // Vertex classes and valences.
-  std::vector<VertexHandle> interior;
+void vertex_figures(const Mesh& mesh, MeshQuality& q, std::vector<VertexHandle>& interior) {
   std::size_t interior_6 = 0;
   std::size_t boundary_4 = 0;
   for (const VertexHandle v : mesh.vertices()) {
@@ -188,7 +178,23 @@ MeshQuality mesh_quality(const Mesh& mesh, const QualityOptions& options) {
   q.interior_vertices = interior.size();
   q.valence.percent_interior_6 = percent(interior_6, q.interior_vertices);
   q.valence.percent_boundary_4 = percent(boundary_4, q.boundary_vertices);
+}
 
+MeshQuality mesh_quality(const Mesh& mesh, const QualityOptions& options) {
+  MeshQuality q;
+
+  // Counts and topology.
+  q.vertices = count(mesh.vertices());
+  q.faces = count(mesh.faces());
+  q.edges = count(mesh.edges());
+  if (options.topology) {
+    q.boundary_loops = boundary_loops(mesh).size();
+    q.component_topology = component_topology(mesh);
+    q.components = q.component_topology.size();
+  }
+
+  std::vector<VertexHandle> interior;
+  vertex_figures(mesh, q, interior);
   q.angles = angle_figures(mesh);
   q.edge_length = edge_length_figures(mesh);
   q.barycentric_area = vertex_area_figures(vertex_areas_barycentric(mesh), interior);

@@ -3,6 +3,7 @@
 #include "remora/multires/bake.h"
 
 #include <cmath>
+#include <ctime>
 #include <functional>
 #include <queue>
 #include <utility>
@@ -103,15 +104,26 @@ void move_base(Bake& b) {
   }
 }
 
+// The process's CPU time in milliseconds.
+double cpu_ms() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return 1e3 * static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_nsec);
+}
+
+// Runs f, adding its wall and CPU time to the report's part.
 template <class F>
 auto timed(BakeReport& report, const char* part, F&& f) {
-  const auto t0 = Clock::now();
   struct Stop {
     BakeReport& report;
     const char* part;
-    Clock::time_point t0;
-    ~Stop() { report.milliseconds[part] += ms_since(t0); }
-  } stop{report, part, t0};
+    Clock::time_point t0 = Clock::now();
+    double cpu0 = cpu_ms();
+    ~Stop() {
+      report.milliseconds[part] += ms_since(t0);
+      report.cpu_milliseconds[part] += cpu_ms() - cpu0;
+    }
+  } stop{report, part};
   return f();
 }
 
@@ -127,20 +139,29 @@ EditorParts local_parts(const Editor& editor, const Eigen::MatrixXd& positions,
   timed(report, "filter", [&] { filter_band(b); });
   timed(report, "base", [&] { move_base(b); });
   progress(1);
+  SpliceMap map;
   const bool has_patch = timed(report, "patch", [&] { return select_patch(b); });
-  if (!has_patch) return timed(report, "stitch", [&] { return stitch(b, nullptr, nullptr); });
+  if (!has_patch) {
+    EditorParts parts = timed(report, "stitch", [&] { return stitch(b, nullptr, nullptr, map); });
+    timed(report, "report", [&] { base_figures(b, parts, nullptr); });
+    return parts;
+  }
   const PatchMeshes meshes = timed(report, "patch", [&] { return patch_meshes(b); });
   progress(2);
   RemeshOptions ro = options.remesh_options;
   ro.target_length = b.old.report.base_target_length;
   ro.threads = options.threads;
   ro.compute_report = false;
+  ro.cycles = settings.cycles;
+  ro.equalize_iterations = settings.equalize_iterations;
   ro.progress = nullptr;
   const RemeshPatchResult remeshed =
       timed(report, "remesh", [&] { return remesh_patch(meshes.reference, meshes.patch, ro); });
   report.patch_faces_after = remeshed.mesh.n_faces();
   progress(3);
-  return timed(report, "stitch", [&] { return stitch(b, &meshes, &remeshed); });
+  EditorParts parts = timed(report, "stitch", [&] { return stitch(b, &meshes, &remeshed, map); });
+  timed(report, "report", [&] { base_figures(b, parts, &map); });
+  return parts;
 }
 
 } // namespace
@@ -159,7 +180,9 @@ BakeResult bake(Editor& editor, const BakeOptions& options) {
     reason = "the base keeps feature lines";
   if (reason.empty()) {
     try {
+      const double cpu0 = bake_detail::cpu_ms();
       EditorParts parts = bake_detail::local_parts(editor, positions, options, report);
+      report.cpu_milliseconds["total"] = bake_detail::cpu_ms() - cpu0;
       Editor baked(std::move(parts), editor.options());
       report.local = true;
       report.milliseconds["total"] = ms_since(t0);

@@ -3,13 +3,16 @@
 //
 //   1. Filter: the low-pass filter is linear, S' = F(O') = S + F(O' − O), and O' − O vanishes
 //      outside the vertices the edit moved. F(O' − O) is solved on those vertices and a band of
-//      `margin` σ around them (LowPassFilter::apply_local); S' = S bit for bit outside.
+//      `margin` σ around them (LowPassFilter::apply_local); S' = S bit for bit outside. F keeps
+//      the metric of the input the first editor was built from (a full preprocess filters with
+//      O''s): the difference is of the size of what two equally good bases of one shape differ.
 //   2. Base: a base vertex located (base_on_input) on a face that S' moves goes with it,
 //      B'_v = S' at its location; every other base vertex keeps its point bit for bit.
 //   3. Patch: where a base edge's length changed by more than `distortion`, its faces and
 //      `rings` rings around them are remeshed again with the base's own l and mean area, their
 //      border locked, on the part of S' under them (remesh_patch(), remesh/remesh.h), and
-//      stitched back. Both correspondences are carried over and mended where the base moved.
+//      spliced back (mesh/splice.h). Both correspondences are carried over and mended where the
+//      base moved; the report's base figures are updated where the base changed.
 //   4. The new editor adopts O', S', the filter (O's, shared: the metric stays the one the
 //      editor was built with), the base and the correspondences (Editor(EditorParts, ...)).
 //
@@ -27,13 +30,19 @@
 namespace remora {
 
 struct BakeOptions {
-  /// Width of the filter's band around the moved input vertices, in σ (the filter's kernel
-  /// decays like exp(−d/σ): at 8 σ the band's truncation is a few 1e-4 of the change).
-  double margin = 8.0;
+  /// Width of the filter's band around the moved input vertices, in σ. The filter's kernel
+  /// decays like exp(−d/σ): on the bunny the band's truncation was at most 2.3e-4, 3.8e-5,
+  /// 5.4e-6 and 8.2e-7 of the bounding-box diagonal at 2, 4, 6 and 8 σ (docs/editing.md).
+  double margin = 6.0;
   /// A base edge whose length changed by more than this fraction makes its faces part of the
   /// patch that is remeshed again.
-  double distortion = 0.02;
+  double distortion = 0.05;
   int rings = 2; ///< rings of base faces added around the distorted ones
+  /// The patch's remesh: cycles (then more while they still change it, as RemeshOptions says)
+  /// and fine-tuning iterations. It starts from a remesh only stretched a little, and needs
+  /// fewer than a remesh of the raw input (docs/editing.md has what fewer cost and saved).
+  int cycles = 4;
+  int equalize_iterations = 6;
   /// The full preprocess runs instead when the band holds more than this share of the input's
   /// vertices, or the patch more than this share of the base's faces.
   double max_fraction = 0.5;
@@ -53,6 +62,9 @@ struct BakeReport {
   /// Wall time: "filter", "base", "patch" (selection and sub-meshes), "remesh", "stitch",
   /// "report", "total"; only "total" for the full preprocess.
   std::map<std::string, double> milliseconds;
+  /// The process's CPU time (all threads) in the same parts: on a busy machine the wall time
+  /// says little about a part's own work.
+  std::map<std::string, double> cpu_milliseconds;
 };
 
 struct BakeResult {

@@ -11,6 +11,7 @@
 #include <Eigen/Core>
 
 #include "remora/common/error.h"
+#include "remora/mesh/splice.h"
 #include "remora/multires/bake.h"
 #include "remora/remesh/remesh.h"
 
@@ -54,9 +55,13 @@ bool select_patch(Bake& b);
 /// The patch and its reference as meshes (bake_patch.cpp). Throws NotLocal when a part of the
 /// patch has no border.
 PatchMeshes patch_meshes(const Bake& b);
-/// The new editor's pieces: the base with `remeshed` in place of the patch (or B' alone when
-/// there is none), both correspondences, the base's figures. Throws NotLocal when a
-/// correspondence cannot be carried over.
-EditorParts stitch(Bake& b, const PatchMeshes* meshes, const RemeshPatchResult* remeshed);
+/// The new editor's pieces: the base with `remeshed` spliced in place of the patch (`map` says
+/// where its elements went), or B' alone when there is none, and both correspondences. Throws
+/// NotLocal when a correspondence cannot be carried over.
+EditorParts stitch(Bake& b, const PatchMeshes* meshes, const RemeshPatchResult* remeshed,
+                   SpliceMap& map);
+/// The new base's figures into parts.report, its negative cotan edges and statistics: updated
+/// where the base changed (`map` as stitch() made it; null without a patch).
+void base_figures(const Bake& b, EditorParts& parts, const SpliceMap* map);
 
 } // namespace remora::bake_detail

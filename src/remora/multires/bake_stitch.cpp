@@ -82,22 +82,35 @@ std::vector<SurfacePoint> mend_input_on_base(const Bake& b, const Mesh& base, co
   return out;
 }
 
-// The base's edges with a negative cotan weight: the old ones where no face around them changed,
-// and those around the changed faces (the patch's and those with a moved vertex) measured again.
-std::vector<std::pair<int, int>> negative_edges(const Bake& b, const Mesh& base,
-                                                const SpliceMap* map) {
-  std::vector<char> changed(base.n_faces(), 0);
-  if (map)
-    for (const int f : map->patch_faces) changed[static_cast<std::size_t>(f)] = 1;
+// What the bake changed in the base (base_figures.h): the patch's faces, old and new, and the
+// kept faces with a moved corner.
+BaseChange base_change(const Bake& b, const SpliceMap* map) {
+  BaseChange c;
+  if (map) {
+    c.vertex_map = map->vertices;
+    c.new_faces = map->patch_faces;
+  }
   const TriangleTopology& t = b.old.topology;
   for (std::size_t f = 0; f < t.faces.size(); ++f) {
-    const int g = map ? map->faces[f] : static_cast<int>(f);
     const auto& fv = t.faces[f];
-    if (g >= 0 &&
-        (b.moved[static_cast<std::size_t>(fv[0])] || b.moved[static_cast<std::size_t>(fv[1])] ||
-         b.moved[static_cast<std::size_t>(fv[2])]))
-      changed[static_cast<std::size_t>(g)] = 1;
+    if (b.patch[f]) {
+      c.old_faces.push_back(static_cast<int>(f));
+    } else if (b.moved[static_cast<std::size_t>(fv[0])] ||
+               b.moved[static_cast<std::size_t>(fv[1])] ||
+               b.moved[static_cast<std::size_t>(fv[2])]) {
+      c.old_faces.push_back(static_cast<int>(f));
+      c.new_faces.push_back(map ? map->faces[f] : static_cast<int>(f));
+    }
   }
+  return c;
+}
+
+// The base's edges with a negative cotan weight: the old ones where no face around them changed,
+// and those around the changed faces measured again.
+std::vector<std::pair<int, int>> negative_edges(const Bake& b, const Mesh& base,
+                                                const SpliceMap* map, const BaseChange& change) {
+  std::vector<char> changed(base.n_faces(), 0);
+  for (const int f : change.new_faces) changed[static_cast<std::size_t>(f)] = 1;
   auto near_change = [&](EdgeHandle e) {
     for (int side = 0; side < 2; ++side) {
       const FaceHandle f = base.face_handle(base.halfedge_handle(e, side));
@@ -130,10 +143,11 @@ std::vector<std::pair<int, int>> negative_edges(const Bake& b, const Mesh& base,
   return out;
 }
 
+} // namespace
+
 // The base's figures for the report: the topological ones (the bake keeps the topology) from the
-// old report, the others measured again.
+// old report, the others updated where the base changed (base_figures.h).
 void base_figures(const Bake& b, EditorParts& parts, const SpliceMap* map) {
-  const auto t0 = Clock::now();
   EditReport& r = parts.report;
   const EditReport& old = b.old.report;
   r.remeshed = true;
@@ -148,13 +162,10 @@ void base_figures(const Bake& b, EditorParts& parts, const SpliceMap* map) {
   r.base_target_length = old.base_target_length;
   r.base_vertices = parts.base.n_vertices();
   r.base_faces = parts.base.n_faces();
-  parts.negative_edges = negative_edges(b, parts.base, map);
-  r.base_symmetry_defect = laplacian_symmetry_defect(parts.base);
-  r.base_quality = mesh_quality(parts.base, {.topology = false});
-  const MeshQuality& q = old.base_quality;
-  r.base_quality.boundary_loops = q.boundary_loops;
-  r.base_quality.components = q.components;
-  r.base_quality.component_topology = q.component_topology;
+  const BaseChange change = base_change(b, map);
+  parts.negative_edges = negative_edges(b, parts.base, map, change);
+  update_base_figures(b.old.base, old.base_quality, b.old.statistics, parts.base, change,
+                      r.base_quality, r.base_symmetry_defect, parts.statistics);
   if (r.base_quality.component_topology.size() == 1) {
     ComponentTopology& c = r.base_quality.component_topology.front();
     c.vertices = static_cast<int>(r.base_quality.vertices);
@@ -163,12 +174,9 @@ void base_figures(const Bake& b, EditorParts& parts, const SpliceMap* map) {
   } else {
     r.base_quality.component_topology = component_topology(parts.base);
   }
-  b.report.milliseconds["report"] += ms_since(t0);
 }
 
-} // namespace
-
-EditorParts stitch(Bake& b, const PatchMeshes* m, const RemeshPatchResult* r) {
+EditorParts stitch(Bake& b, const PatchMeshes* m, const RemeshPatchResult* r, SpliceMap& map) {
   EditorParts parts;
   parts.input = b.old.input;
   for (std::size_t i = 0; i < b.in_band.size(); ++i)
@@ -178,7 +186,6 @@ EditorParts stitch(Bake& b, const PatchMeshes* m, const RemeshPatchResult* r) {
   parts.input_positions = b.input_positions;
   parts.input_topology = b.old.input_topology;
   parts.filter = b.old.filter;
-  SpliceMap map;
   if (m) {
     parts.base = stitched_base(b, *m, *r, parts.base_on_input, map);
   } else {
@@ -193,7 +200,6 @@ EditorParts stitch(Bake& b, const PatchMeshes* m, const RemeshPatchResult* r) {
   parts.smooth = std::move(b.smooth);
   parts.topology = m ? triangle_topology(parts.base) : b.old.topology;
   parts.base_rest = positions_matrix(parts.base);
-  base_figures(b, parts, m ? &map : nullptr);
   return parts;
 }
 

@@ -86,6 +86,7 @@ struct Editor::Impl {
   Eigen::MatrixXd base_rest; // B
   std::vector<SurfacePoint> base_on_input, input_on_base;
   std::vector<std::pair<int, int>> negative_edges; // of B
+  BaseStatistics statistics;                       // of B: what a bake updates the report from
   std::unique_ptr<MultigridSolver> multigrid;
   EditReport report;
   std::unique_ptr<RegionState> region;
@@ -220,6 +221,7 @@ Editor::Editor(Mesh mesh, EditorOptions options) : impl_(std::make_unique<Impl>(
         m.negative_edges.emplace_back(static_cast<int>(it.row()), static_cast<int>(it.col()));
   m.report.base_symmetry_defect = laplacian_symmetry_defect(m.base);
   m.report.base_quality = mesh_quality(m.base);
+  m.statistics = base_statistics(m.base);
   m.report.milliseconds["base report"] = ms_since(t0);
 }
 
@@ -247,6 +249,7 @@ Editor::Editor(EditorParts parts, EditorOptions options) : impl_(std::make_uniqu
   m.base_on_input = std::move(parts.base_on_input);
   m.input_on_base = std::move(parts.input_on_base);
   m.negative_edges = std::move(parts.negative_edges);
+  m.statistics = std::move(parts.statistics);
   m.report = std::move(parts.report);
 }
 
@@ -656,7 +659,7 @@ EditorPartsView Editor::parts() const {
   const Impl& m = *impl_;
   return {m.input,          m.input_positions, m.input_topology, m.filter,        m.smooth,
           m.base,           m.topology,        m.base_rest,      m.base_on_input, m.input_on_base,
-          m.negative_edges, m.report};
+          m.negative_edges, m.statistics,      m.report};
 }
 
 nlohmann::json to_json(const EditReport& r) {

@@ -30,6 +30,7 @@
 #include <memory>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -39,6 +40,7 @@
 #include "remora/linalg/kharmonic.h"
 #include "remora/linalg/solver.h"
 #include "remora/mesh/mesh.h"
+#include "remora/multires/base_figures.h"
 #include "remora/multires/base_surface.h"
 #include "remora/multires/phong.h"
 #include "remora/remesh/remesh.h"
@@ -132,7 +134,8 @@ struct EditorParts {
   Eigen::MatrixXd base_rest; ///< B
   std::vector<SurfacePoint> base_on_input, input_on_base;
   std::vector<std::pair<int, int>> negative_edges; ///< base edges with a negative cotan weight
-  EditReport report;                               ///< the base's figures
+  BaseStatistics statistics; ///< per base vertex, what the report's figures sum
+  EditReport report;         ///< the base's figures
 };
 
 /// The same pieces of an existing editor, read-only (what a bake reads).
@@ -148,6 +151,7 @@ struct EditorPartsView {
   const std::vector<SurfacePoint>& base_on_input;
   const std::vector<SurfacePoint>& input_on_base;
   const std::vector<std::pair<int, int>>& negative_edges;
+  const BaseStatistics& statistics;
   const EditReport& report;
 };
 
