@@ -36,10 +36,10 @@ struct BenchBakeArgs {
   int repeat = 3;
   double move = 0.05; ///< the handle's lift, in bounding-box diagonals
   double margin = BakeOptions{}.margin;
+  double max_fraction = BakeOptions{}.max_fraction;
   bool compare = false;
   int session = 0;
   int threads = 0;
-  bool json = false;
 };
 
 /// A geodesic support of `count` input vertices around `seed`, its innermost 3 % the handle.
@@ -207,6 +207,7 @@ void run_bench_bake(const BenchBakeArgs& a) {
     last.reset();
     BakeOptions bo;
     bo.margin = a.margin;
+    bo.max_fraction = a.max_fraction;
     const double cpu0 = cpu_ms();
     last.emplace(bake(editor, bo));
     const double cpu = cpu_ms() - cpu0;
@@ -242,6 +243,8 @@ void add_bench_bake_command(CLI::App& bench) {
       ->check(CLI::PositiveNumber);
   cmd->add_option("--move", a->move, "The handle's lift in bounding-box diagonals (0.05)");
   cmd->add_option("--margin", a->margin, "The filter's band in σ (BakeOptions::margin)");
+  cmd->add_option("--max-fraction", a->max_fraction,
+                  "The band's or patch's share above which the full preprocess runs");
   cmd->add_flag("--compare", a->compare,
                 "Also the full preprocess, and the agreement after the same next edit");
   cmd->add_option("--session", a->session,
