@@ -149,6 +149,46 @@ TEST(ServerEditing, AFailedRegionAfterAStoppedOneLeavesTheSessionsRegion) {
   EXPECT_EQ(as<float>(move(s, lift)), moved);
 }
 
+// A new region after a move bakes the edited shape locally (only around the move), and undo and
+// redo through several such bakes give back every state's positions bit for bit.
+TEST(ServerEditing, UndoAndRedoThroughLocalBakesAreExact) {
+  Session s;
+  ASSERT_EQ(call(s, "POST", "/api/load", sphere_off(5), {{"name", "fine.off"}}).status, 202);
+  s.wait();
+  const auto rest = as<float>(call(s, "GET", "/api/mesh/positions"));
+  std::vector<int> support, handle;
+  for (std::size_t v = 0; v < rest.size() / 3; ++v) {
+    if (rest[3 * v + 2] > 0.85) support.push_back(static_cast<int>(v));
+    if (rest[3 * v + 2] > 0.97) handle.push_back(static_cast<int>(v));
+  }
+  // The positions of every state of the history: the load, then per round the region (the shape
+  // as baked) and the move.
+  std::vector<std::vector<float>> steps{rest};
+  for (int i = 0; i < 3; ++i) {
+    const json region = {{"support", support}, {"handles", {handle}}, {"k", 2}};
+    ASSERT_EQ(call(s, "POST", "/api/region", region.dump()).status, 202);
+    s.wait();
+    const json status = status_of(s);
+    ASSERT_FALSE(status.contains("error")) << status;
+    if (i > 0) {
+      EXPECT_TRUE(status["base"]["bake"]["local"].get<bool>()) << status["base"];
+    }
+    steps.push_back(as<float>(call(s, "GET", "/api/mesh/positions")));
+    const double lift = i % 2 == 0 ? 0.1 : -0.05;
+    ASSERT_EQ(move(s, {1, 0, 0, 0, 0, 1, 0, 0.05 * i, 0, 0, 1, lift}).status, 200);
+    call(s, "POST", "/api/commit");
+    steps.push_back(as<float>(call(s, "GET", "/api/mesh/positions")));
+  }
+  for (std::size_t k = steps.size() - 1; k-- > 0;) {
+    ASSERT_TRUE(json::parse(call(s, "POST", "/api/undo").body)["changed"]);
+    EXPECT_EQ(as<float>(call(s, "GET", "/api/mesh/positions")), steps[k]) << "undo to step " << k;
+  }
+  for (std::size_t k = 1; k < steps.size(); ++k) {
+    ASSERT_TRUE(json::parse(call(s, "POST", "/api/redo").body)["changed"]);
+    EXPECT_EQ(as<float>(call(s, "GET", "/api/mesh/positions")), steps[k]) << "redo to step " << k;
+  }
+}
+
 TEST(ServerEditing, MirrorsCollapsesAndNumbersOutOfRangeAreRefused) {
   Session s;
   load_sphere_with_region(s);

@@ -16,5 +16,7 @@ void add_serve_command(CLI::App& app);
 void add_bench_edit_command(CLI::App& bench);
 /// `remora bench serve`, a subcommand of `remora bench`.
 void add_bench_serve_command(CLI::App& bench);
+/// `remora bench bake`, a subcommand of `remora bench`.
+void add_bench_bake_command(CLI::App& bench);
 
 } // namespace remora::cli

@@ -13,6 +13,7 @@
 #include "remora/geometry/quality.h"
 #include "remora/linalg/kharmonic.h"
 #include "remora/mesh/io.h"
+#include "remora/multires/bake.h"
 
 namespace remora::server {
 
@@ -31,6 +32,7 @@ struct EditorBox {
   Editor editor;
   std::optional<RegionKey> region;
   double preprocess_ms = 0.0;
+  std::optional<BakeReport> bake; ///< how a bake made it (none for a load)
 };
 
 struct Snapshot {
@@ -50,6 +52,7 @@ bool is_identity(const std::vector<Transform>& transforms) {
 /// the remesh); the bar moves forward, it does not promise a time.
 std::pair<double, double> preprocess_share(std::string_view phase) {
   if (phase == "reading") return {0.0, 0.05};
+  if (phase == "bake") return {0.0, 1.0}; // a local bake; a full one reports the phases below
   if (phase == "base surface") return {0.05, 0.2};
   if (phase == "remesh: remesh") return {0.2, 0.6};
   if (phase == "remesh: equalize") return {0.6, 0.9};
@@ -203,10 +206,13 @@ struct Session::Impl {
       std::lock_guard lock(mutex);
       if (baked && baked_from == current && baked_transforms == moved_by) return baked;
     }
+    // The edited shape becomes the next input: filtered and remeshed again where the edit
+    // changed it (multires/bake.h), or in full where that cannot work.
     const auto t0 = Clock::now();
-    Mesh result = current->editor.result();
-    auto next = std::make_shared<EditorBox>(Editor(std::move(result), editor_options()));
+    BakeResult result = remora::bake(current->editor);
+    auto next = std::make_shared<EditorBox>(std::move(result.editor));
     next->preprocess_ms = ms_since(t0);
+    next->bake = std::move(result.report);
     std::lock_guard lock(mutex);
     baked = next;
     baked_from = current;
@@ -414,6 +420,10 @@ nlohmann::json Session::status() const {
                {"area_rel_mad", r.base_quality.mixed_area.rel_mad},
                {"min_angle_deg", r.base_quality.angles.min_deg},
                {"symmetry_defect", r.base_symmetry_defect}};
+  if (m.box->bake)
+    j["base"]["bake"] = {{"local", m.box->bake->local},
+                         {"fallback", m.box->bake->fallback},
+                         {"milliseconds", m.box->bake->milliseconds}};
   j["k"] = m.region ? m.region->k : m.box->editor.options().system.k;
   j["frame_ms"] = m.last_frame_ms;
   if (m.region) {

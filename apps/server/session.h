@@ -7,7 +7,9 @@
 // History: every load, region and committed transform is a snapshot (editor, region, k,
 // transforms). Undo and redo re-apply a snapshot; the same editor, region and transforms give the
 // same positions bit for bit. A new region after non-identity transforms first bakes the current
-// result into a new editor (the edited shape becomes the next input), as a user expects.
+// result into a new editor (the edited shape becomes the next input), as a user expects: locally,
+// only where the edit changed the shape (multires/bake.h), or in full where that cannot work.
+// The editors a history keeps share nothing they change (a bake's share the immutable filter).
 #pragma once
 
 #include <chrono>

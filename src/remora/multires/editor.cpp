@@ -85,7 +85,8 @@ struct Editor::Impl {
   Mesh input;
   Eigen::MatrixXd input_positions;
   TriangleTopology input_topology;
-  std::optional<LowPassFilter> filter;
+  std::shared_ptr<const LowPassFilter> filter; // immutable: editors made by a bake share it
+  Eigen::MatrixXd smooth;                      // S = filter(O)
   Mesh base;
   TriangleTopology topology;
   Eigen::MatrixXd base_rest;    // B
@@ -93,6 +94,7 @@ struct Editor::Impl {
   std::vector<SurfacePoint> base_on_input, input_on_base;
   std::vector<std::pair<int, int>> negative_edges; // of B
   std::optional<KHarmonicAssembler> assembler;     // B's systems
+  BaseStatistics statistics;                       // of B: what a bake updates the report from
   std::unique_ptr<MultigridSolver> multigrid;
   EditReport report;
   std::unique_ptr<RegionState> region;
@@ -178,8 +180,8 @@ Editor::Editor(Mesh mesh, EditorOptions options) : impl_(std::make_unique<Impl>(
   auto t0 = Clock::now();
   LowPassOptions filter_options = m.options.base;
   if (filter_options.threads == 0) filter_options.threads = m.options.threads;
-  m.filter.emplace(m.input, filter_options);
-  const Eigen::MatrixXd smooth = m.filter->apply(m.input_positions);
+  m.filter = std::make_shared<const LowPassFilter>(m.input, filter_options);
+  m.smooth = m.filter->apply(m.input_positions);
   m.report.sigma = m.filter->stats().sigma;
   m.report.sigma_min = m.filter->stats().sigma_min;
   m.report.sigma_capped_vertices = m.filter->stats().capped;
@@ -187,7 +189,7 @@ Editor::Editor(Mesh mesh, EditorOptions options) : impl_(std::make_unique<Impl>(
   m.report.intrinsic_flips = m.filter->stats().laplacian_stats.flips;
   m.report.input_negative_weights = m.filter->stats().laplacian_stats.negative_before;
   Mesh s = m.input;
-  set_positions(s, smooth);
+  set_positions(s, m.smooth);
   m.report.milliseconds["base"] = ms_since(t0);
 
   // 3. The base B: the area-equalizing remesh of S, with the correspondence.
@@ -233,7 +235,38 @@ Editor::Editor(Mesh mesh, EditorOptions options) : impl_(std::make_unique<Impl>(
         m.negative_edges.emplace_back(static_cast<int>(it.row()), static_cast<int>(it.col()));
   m.report.base_symmetry_defect = laplacian_symmetry_defect(m.base);
   m.report.base_quality = mesh_quality(m.base);
+  m.statistics = base_statistics(m.base);
   m.report.milliseconds["base report"] = ms_since(t0);
+}
+
+Editor::Editor(EditorParts parts, EditorOptions options) : impl_(std::make_unique<Impl>()) {
+  Impl& m = *impl_;
+  check_options(options);
+  const auto ni = static_cast<Eigen::Index>(parts.input.n_vertices());
+  const auto nb = static_cast<Eigen::Index>(parts.base.n_vertices());
+  if (!options.remesh || !parts.filter || parts.input_positions.rows() != ni ||
+      parts.smooth.rows() != ni || parts.input_on_base.size() != std::size_t(ni) ||
+      parts.base_rest.rows() != nb || parts.base_on_input.size() != std::size_t(nb) ||
+      parts.topology.faces.size() != parts.base.n_faces() ||
+      parts.input_topology.faces.size() != parts.input.n_faces())
+    throw InvalidArgument("editor parts: the sizes of the input, the base and their "
+                          "correspondences disagree (or remesh is off)");
+  m.options = std::move(options);
+  m.input = std::move(parts.input);
+  m.input_positions = std::move(parts.input_positions);
+  m.input_topology = std::move(parts.input_topology);
+  m.filter = std::move(parts.filter);
+  m.smooth = std::move(parts.smooth);
+  m.base = std::move(parts.base);
+  m.topology = std::move(parts.topology);
+  m.base_rest = std::move(parts.base_rest);
+  m.base_on_input = std::move(parts.base_on_input);
+  m.input_on_base = std::move(parts.input_on_base);
+  m.negative_edges = std::move(parts.negative_edges);
+  m.statistics = std::move(parts.statistics);
+  m.report = std::move(parts.report);
+  m.base_normals = vertex_normals(m.topology, m.base_rest);
+  m.assembler.emplace(m.base, m.options.threads);
 }
 
 Editor::Editor(Editor&&) noexcept = default;
@@ -682,6 +715,13 @@ const EditReport& Editor::report() const {
 }
 const EditorOptions& Editor::options() const {
   return impl_->options;
+}
+
+EditorPartsView Editor::parts() const {
+  const Impl& m = *impl_;
+  return {m.input,          m.input_positions, m.input_topology, m.filter,        m.smooth,
+          m.base,           m.topology,        m.base_rest,      m.base_on_input, m.input_on_base,
+          m.negative_edges, m.statistics,      m.report};
 }
 
 nlohmann::json to_json(const EditReport& r) {

@@ -31,6 +31,7 @@
 #include <stop_token>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -40,6 +41,7 @@
 #include "remora/linalg/kharmonic.h"
 #include "remora/linalg/solver.h"
 #include "remora/mesh/mesh.h"
+#include "remora/multires/base_figures.h"
 #include "remora/multires/base_surface.h"
 #include "remora/multires/phong.h"
 #include "remora/remesh/remesh.h"
@@ -120,11 +122,51 @@ struct EditReport {
 
 nlohmann::json to_json(const EditReport& report);
 
+/// The preprocessed pieces of an editor (steps 1-3), as a bake (multires/bake.h) hands them to
+/// a new editor: O, its low-pass S, the base B with both correspondences, and the base's figures.
+/// Shapes: input_positions and smooth n_input × 3, base_rest n_base × 3; base_on_input has a
+/// location on O per base vertex, input_on_base one on B per input vertex (invalid face for an
+/// isolated one).
+struct EditorParts {
+  Mesh input;
+  Eigen::MatrixXd input_positions; ///< O
+  TriangleTopology input_topology;
+  std::shared_ptr<const LowPassFilter> filter; ///< immutable, shared by the editors of a bake
+  Eigen::MatrixXd smooth;                      ///< S = filter(O)
+  Mesh base;
+  TriangleTopology topology;
+  Eigen::MatrixXd base_rest; ///< B
+  std::vector<SurfacePoint> base_on_input, input_on_base;
+  std::vector<std::pair<int, int>> negative_edges; ///< base edges with a negative cotan weight
+  BaseStatistics statistics; ///< per base vertex, what the report's figures sum
+  EditReport report;         ///< the base's figures
+};
+
+/// The same pieces of an existing editor, read-only (what a bake reads).
+struct EditorPartsView {
+  const Mesh& input;
+  const Eigen::MatrixXd& input_positions;
+  const TriangleTopology& input_topology;
+  const std::shared_ptr<const LowPassFilter>& filter;
+  const Eigen::MatrixXd& smooth;
+  const Mesh& base;
+  const TriangleTopology& topology;
+  const Eigen::MatrixXd& base_rest;
+  const std::vector<SurfacePoint>& base_on_input;
+  const std::vector<SurfacePoint>& input_on_base;
+  const std::vector<std::pair<int, int>>& negative_edges;
+  const BaseStatistics& statistics;
+  const EditReport& report;
+};
+
 class Editor {
 public:
   /// Steps 1-3. `mesh` must be a repaired mesh without deleted elements (read_mesh() gives one).
   /// Throws InvalidArgument for an empty mesh, non-finite points or bad options.
   explicit Editor(Mesh mesh, EditorOptions options = {});
+  /// Steps 1-3 adopted from a bake (multires/bake.h), nothing recomputed; `options` as they made
+  /// the pieces, remesh on. Throws InvalidArgument when the pieces' sizes disagree.
+  Editor(EditorParts parts, EditorOptions options);
   Editor(Editor&&) noexcept;
   Editor& operator=(Editor&&) noexcept;
   ~Editor();
@@ -199,6 +241,8 @@ public:
 
   const EditReport& report() const;
   const EditorOptions& options() const;
+  /// Steps 1-3's pieces, read-only (valid while the editor lives and is not moved from).
+  EditorPartsView parts() const;
 
 private:
   struct Impl;
