@@ -21,6 +21,7 @@ struct RegionKey {
   std::vector<int> support;
   std::vector<std::vector<int>> handles;
   int k = 2;
+  EditMethod method = EditMethod::Linear;
   bool operator==(const RegionKey&) const = default;
 };
 
@@ -37,6 +38,16 @@ struct Snapshot {
   std::optional<RegionKey> region;
   std::vector<Transform> transforms;
 };
+
+/// The movable vertices' rows of `p` as interleaved Float32.
+std::vector<float> movable_floats(const Editor& editor, const Eigen::MatrixXd& p) {
+  const std::vector<int>& movable = editor.movable_vertices();
+  std::vector<float> out(3 * movable.size());
+  for (std::size_t i = 0; i < movable.size(); ++i)
+    for (int c = 0; c < 3; ++c)
+      out[3 * i + static_cast<std::size_t>(c)] = static_cast<float>(p(movable[i], c));
+  return out;
+}
 
 bool is_identity(const std::vector<Transform>& transforms) {
   for (const Transform& t : transforms)
@@ -115,6 +126,7 @@ struct Session::Impl {
     transforms = s.transforms;
     if (region && box->region != region) {
       box->editor.set_system({region->k, box->editor.options().system.areas});
+      box->editor.set_method(region->method);
       box->editor.set_region(region->support, region->handles);
       box->region = region;
     }
@@ -158,6 +170,19 @@ struct Session::Impl {
       phase.clear();
       idle.notify_all();
     });
+  }
+  /// positions(budget) of the editor, as the answer to a move or a relax step. Under the lock.
+  Frame frame(double budget_ms) {
+    Editor& editor = box->editor;
+    const auto t0 = Clock::now();
+    Frame f;
+    const Eigen::MatrixXd& p = editor.positions(budget_ms);
+    f.positions = movable_floats(editor, p);
+    f.converged = editor.converged();
+    f.iterations = editor.report().method == "nonlinear" ? editor.report().nonlinear.iterations : 0;
+    f.ms = last_frame_ms = ms_since(t0);
+    shape->set_positions(editor.movable_vertices(), p);
+    return f;
   }
   EditorOptions editor_options() {
     EditorOptions o = options.editor;
@@ -218,7 +243,8 @@ void Session::start_load(std::string bytes, std::string name) {
   });
 }
 
-void Session::start_region(std::vector<int> support, std::vector<std::vector<int>> handles, int k) {
+void Session::start_region(std::vector<int> support, std::vector<std::vector<int>> handles, int k,
+                           EditMethod method) {
   std::lock_guard lock(impl_->mutex);
   Impl& m = *impl_;
   m.require_ready();
@@ -235,71 +261,79 @@ void Session::start_region(std::vector<int> support, std::vector<std::vector<int
         throw InvalidArgument(fmt::format("handle vertex {} is out of range (the mesh has {} "
                                           "vertices)",
                                           v, n));
-  RegionKey key{std::move(support), std::move(handles), k};
-  // Only k changes: the same handles keep their transforms, solved again (no bake), so that a
-  // user compares k on the same drag.
-  const bool new_k = m.region && m.region->support == key.support &&
-                     m.region->handles == key.handles && m.region->k != key.k;
-  const bool bake = !new_k && !is_identity(m.transforms);
+  RegionKey key{std::move(support), std::move(handles), k, method};
+  // Only k or the method changes: the same handles keep their transforms, solved again (no
+  // bake), so that a user compares them on the same drag. A new method alone needs no new
+  // set_region.
+  const bool same_paint =
+      m.region && m.region->support == key.support && m.region->handles == key.handles;
+  const bool resolve = same_paint && (m.region->k != key.k || m.region->method != key.method);
+  const bool new_region = !same_paint || m.region->k != key.k;
+  const bool bake = !resolve && !is_identity(m.transforms);
   m.span_begin = 0.0;
   m.span_end = bake ? 0.85 : 0.0;
-  m.run("region",
-        [this, key = std::move(key), bake, new_k, current = m.box, transforms = m.transforms] {
-          Impl& s = *impl_;
-          std::shared_ptr<EditorBox> box = current;
-          if (bake) {
-            // The edited shape becomes the next input: a new base, remeshed.
-            const auto t0 = Clock::now();
-            Mesh result = current->editor.result();
-            box = std::make_shared<EditorBox>(Editor(std::move(result), s.editor_options()));
-            box->preprocess_ms = ms_since(t0);
-          }
-          {
-            std::lock_guard guard(s.mutex);
-            s.report("set_region", 0, 1);
-          }
-          // On a copy of the key: a failure leaves the session as it was.
-          box->editor.set_system({key.k, box->editor.options().system.areas});
-          box->editor.set_region(key.support, key.handles);
-          box->region = key;
-          std::optional<Eigen::MatrixXd> moved;
-          if (new_k) {
-            for (std::size_t j = 0; j < transforms.size(); ++j)
-              box->editor.set_transform(static_cast<int>(j), transforms[j]);
-            moved = box->editor.positions();
-          }
-          std::lock_guard guard(s.mutex);
-          s.box = box;
-          s.region = key;
-          ++s.region_id;
-          if (moved) {
-            s.shape->set_positions(*moved);
-            ++s.positions_id;
-          } else {
-            s.transforms.assign(key.handles.size(), identity_transform());
-          }
-          s.push_snapshot();
-        });
+  m.run("region", [this, key = std::move(key), bake, resolve, new_region, current = m.box,
+                   transforms = m.transforms] {
+    Impl& s = *impl_;
+    std::shared_ptr<EditorBox> box = current;
+    if (bake) {
+      // The edited shape becomes the next input: a new base, remeshed.
+      const auto t0 = Clock::now();
+      Mesh result = current->editor.result();
+      box = std::make_shared<EditorBox>(Editor(std::move(result), s.editor_options()));
+      box->preprocess_ms = ms_since(t0);
+    }
+    {
+      std::lock_guard guard(s.mutex);
+      s.report("set_region", 0, 1);
+    }
+    // On a copy of the key: a failure leaves the session as it was.
+    const EditMethod previous = box->editor.options().method;
+    box->editor.set_system({key.k, box->editor.options().system.areas});
+    box->editor.set_method(key.method);
+    try {
+      if (new_region) box->editor.set_region(key.support, key.handles);
+    } catch (...) {
+      box->editor.set_method(previous);
+      throw;
+    }
+    box->region = key;
+    std::optional<Eigen::MatrixXd> moved;
+    if (resolve) {
+      for (std::size_t j = 0; j < transforms.size(); ++j)
+        box->editor.set_transform(static_cast<int>(j), transforms[j]);
+      moved = box->editor.positions();
+    }
+    std::lock_guard guard(s.mutex);
+    s.box = box;
+    s.region = key;
+    ++s.region_id;
+    if (moved) {
+      s.shape->set_positions(*moved);
+      ++s.positions_id;
+    } else {
+      s.transforms.assign(key.handles.size(), identity_transform());
+    }
+    s.push_snapshot();
+  });
 }
 
-std::vector<float> Session::set_transform(int handle, const Transform& transform,
-                                          double* frame_ms) {
+Frame Session::set_transform(int handle, const Transform& transform) {
   std::lock_guard lock(impl_->mutex);
   Impl& m = *impl_;
   m.require_region();
   m.box->editor.set_transform(handle, transform); // validates
   m.transforms[static_cast<std::size_t>(handle)] = transform;
-  const auto t0 = Clock::now();
-  const Eigen::MatrixXd& p = m.box->editor.positions();
-  const std::vector<int>& movable = m.box->editor.movable_vertices();
-  std::vector<float> out(3 * movable.size());
-  for (std::size_t i = 0; i < movable.size(); ++i)
-    for (int c = 0; c < 3; ++c)
-      out[3 * i + static_cast<std::size_t>(c)] = static_cast<float>(p(movable[i], c));
-  m.last_frame_ms = ms_since(t0);
-  m.shape->set_positions(movable, p);
-  if (frame_ms) *frame_ms = m.last_frame_ms;
-  return out;
+  return m.frame(m.options.frame_budget_ms);
+}
+
+Frame Session::relax(double budget_ms) {
+  std::lock_guard lock(impl_->mutex);
+  Impl& m = *impl_;
+  m.require_region();
+  if (!(budget_ms > 0.0) || !(budget_ms <= 10000.0))
+    throw InvalidArgument("budget_ms: expected milliseconds above 0, at most 10000");
+  return m.frame(budget_ms);
 }
 
 void Session::commit() {
@@ -362,6 +396,7 @@ nlohmann::json Session::status() const {
     j["region"] = {{"support", m.region->support.size()},
                    {"handles", m.region->handles.size()},
                    {"k", m.region->k},
+                   {"method", to_string(m.region->method)},
                    {"free_base_vertices", r.free_base_vertices},
                    {"set_region_ms",
                     r.milliseconds.count("set_region") ? r.milliseconds.at("set_region") : 0.0},
@@ -374,6 +409,10 @@ nlohmann::json Session::status() const {
       transforms.push_back(row_major);
     }
     j["transforms"] = transforms;
+    if (m.region->method == EditMethod::Nonlinear)
+      j["nonlinear"] = {{"iterations", r.nonlinear.total_iterations},
+                        {"converged", m.box->editor.converged()},
+                        {"fallback", r.fallback}};
   }
   return j;
 }
@@ -383,7 +422,10 @@ nlohmann::json Session::region() const {
   const Impl& m = *impl_;
   m.require_ready();
   if (!m.region) return nullptr;
-  return {{"support", m.region->support}, {"handles", m.region->handles}, {"k", m.region->k}};
+  return {{"support", m.region->support},
+          {"handles", m.region->handles},
+          {"k", m.region->k},
+          {"method", to_string(m.region->method)}};
 }
 
 namespace {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <utility>
 
@@ -47,6 +48,17 @@ DetailMode parse_detail_mode(const std::string& name) {
       fmt::format("unknown detail mode '{}': use normal (the paper), displacement or none", name));
 }
 
+std::string to_string(EditMethod method) {
+  return method == EditMethod::Linear ? "linear" : "nonlinear";
+}
+
+EditMethod parse_edit_method(const std::string& name) {
+  if (name == "linear") return EditMethod::Linear;
+  if (name == "nonlinear") return EditMethod::Nonlinear;
+  throw InvalidArgument(fmt::format(
+      "unknown method '{}': use linear (the paper) or nonlinear (large rotations)", name));
+}
+
 // ---- the editor ------------------------------------------------------------------------------
 
 namespace {
@@ -70,6 +82,10 @@ struct RegionState {
   Eigen::MatrixXd current_positions;
   std::vector<double> face_normals; // update_normals()'s scratch
   bool dirty = true;
+  // Method nonlinear (multires/nonlinear.h): null when building it failed (deformer_error says
+  // why; the frames then show the linear result).
+  std::unique_ptr<NonlinearDeformer> deformer;
+  std::string deformer_error, fallback;
 };
 
 } // namespace
@@ -100,7 +116,9 @@ struct Editor::Impl {
     if (!region) throw InvalidArgument("no region yet: call set_region() first");
     return *region;
   }
-  void update();
+  void update(double budget_ms);
+  void build_deformer(RegionState& r);
+  void deform_base(RegionState& r, bool moved, double budget_ms);
 
   // The steps of set_region(), in order, on a new state (the current region stays until all
   // succeed).
@@ -458,6 +476,57 @@ void Editor::Impl::find_affected(RegionState& r) const {
   r.affected = plan_normals(topology, vertices);
 }
 
+// Method nonlinear: the deformer from B0, the labels and the handles' scalar weights (the basis
+// functions' "1" columns). A failure leaves the linear method in place, with the reason.
+void Editor::Impl::build_deformer(RegionState& r) {
+  if (options.method != EditMethod::Nonlinear) return;
+  const auto t0 = Clock::now();
+  Eigen::MatrixXd weights = Eigen::MatrixXd::Zero(r.rest.rows(), r.handles);
+  for (std::size_t row = 0; row < r.free_vertices.size(); ++row)
+    for (int j = 0; j < r.handles; ++j)
+      weights(r.free_vertices[row], j) =
+          static_cast<double>(r.basis(static_cast<Eigen::Index>(row), 3 + 4 * j + 3));
+  for (int j = 0; j < r.handles; ++j)
+    for (const int v : r.handle_base[static_cast<std::size_t>(j)]) weights(v, j) = 1.0;
+  NonlinearOptions o = options.nonlinear;
+  o.threads = options.threads;
+  try {
+    r.deformer = std::make_unique<NonlinearDeformer>(base, r.rest, r.base_label, weights, o);
+  } catch (const Error& e) {
+    r.deformer_error = fmt::format("the nonlinear method is off for this region ({}); the "
+                                   "linear result is shown",
+                                   e.what());
+  }
+  report.milliseconds["nonlinear setup"] = ms_since(t0);
+}
+
+// Method nonlinear, in a frame: r.current_base holds the blend (the linear result); the deformer
+// replaces its free rows, or the blend stays with a message when the iteration fails.
+void Editor::Impl::deform_base(RegionState& r, bool moved, double budget_ms) {
+  if (!r.deformer && r.deformer_error.empty()) build_deformer(r); // after set_method()
+  const auto t0 = Clock::now();
+  report.method = "nonlinear";
+  if (moved) r.fallback.clear();
+  if (!r.deformer) {
+    r.fallback = r.deformer_error;
+  } else if (r.fallback.empty()) {
+    try {
+      if (moved) r.deformer->set_transforms(r.transforms, &r.current_base);
+      report.nonlinear = r.deformer->solve(budget_ms);
+      const RowPoints& x = r.deformer->positions();
+      for (const int v : r.free_vertices)
+        if (!x.row(v).allFinite())
+          throw NumericalError("the iteration produced a non-finite position");
+      for (const int v : r.free_vertices) r.current_base.row(v) = x.row(v);
+    } catch (const Error& e) {
+      r.fallback =
+          fmt::format("the nonlinear iteration failed ({}); the linear result is shown", e.what());
+    }
+  }
+  report.fallback = r.fallback;
+  report.milliseconds["frame nonlinear"] = ms_since(t0);
+}
+
 void Editor::set_region(const std::vector<int>& support,
                         const std::vector<std::vector<int>>& handles) {
   Impl& m = *impl_;
@@ -469,6 +538,7 @@ void Editor::set_region(const std::vector<int>& support,
   m.solve_basis(r);
   m.encode_details(r);
   m.find_affected(r);
+  m.build_deformer(r);
   r.transforms.assign(static_cast<std::size_t>(r.handles), identity_transform());
   r.current_base = r.rest;
   r.current_normals = r.rest_normals;
@@ -502,6 +572,14 @@ void Editor::set_system(const KHarmonicOptions& system) {
   impl_->options.system = system;
 }
 
+void Editor::set_method(EditMethod method) {
+  Impl& m = *impl_;
+  m.options.method = method;
+  if (!m.region) return;
+  m.region->fallback.clear();
+  m.region->dirty = true;
+}
+
 Eigen::Vector3d Editor::handle_center(int handle) const {
   const RegionState& r = impl_->state();
   check_handle(r, handle);
@@ -533,9 +611,10 @@ const Transform& Editor::transform(int handle) const {
   return r.transforms[static_cast<std::size_t>(handle)];
 }
 
-void Editor::Impl::update() {
+void Editor::Impl::update(double budget_ms) {
   RegionState& r = state();
-  if (!r.dirty) return;
+  const bool iterating = r.deformer && r.fallback.empty() && !r.deformer->stats().finished();
+  if (!r.dirty && !iterating) return;
   const auto t0 = Clock::now();
   // Blend: X_free = Φ_0 + Σ_j Φ_j [M_jᵀ; t_jᵀ].
   Eigen::MatrixXd coefficients(3 + 4 * r.handles, 3);
@@ -550,8 +629,10 @@ void Editor::Impl::update() {
       r.current_base.row(v) =
           (t.leftCols<3>() * base_rest.row(v).transpose() + t.col(3)).transpose();
   }
-  const auto t_normals = Clock::now();
   report.milliseconds["frame blend"] = ms_since(t0);
+  report.method = to_string(options.method);
+  if (options.method == EditMethod::Nonlinear) deform_base(r, r.dirty, budget_ms);
+  const auto t_normals = Clock::now();
   // Normals where they can change.
   update_normals(topology, r.current_base, r.affected, r.current_normals, r.face_normals, threads);
   const auto t_decode = Clock::now();
@@ -582,8 +663,18 @@ void Editor::Impl::update() {
 }
 
 const Eigen::MatrixXd& Editor::positions() {
-  impl_->update();
+  return positions(std::numeric_limits<double>::infinity());
+}
+
+const Eigen::MatrixXd& Editor::positions(double budget_ms) {
+  impl_->update(budget_ms);
   return impl_->region->current_positions;
+}
+
+bool Editor::converged() const {
+  const RegionState* r = impl_->region.get();
+  if (!r || !r->deformer || !r->fallback.empty()) return true;
+  return !r->dirty && r->deformer->stats().finished();
 }
 
 Mesh Editor::result() {
@@ -602,7 +693,7 @@ const Mesh& Editor::base() const {
 }
 
 Eigen::MatrixXd Editor::base_positions() {
-  impl_->update();
+  impl_->update(std::numeric_limits<double>::infinity());
   return impl_->region->current_base;
 }
 
@@ -655,6 +746,14 @@ nlohmann::json to_json(const EditReport& r) {
                 {"extrapolated", r.phong.extrapolated},
                 {"fallbacks", r.phong.fallbacks},
                 {"max_abs_offset", r.phong.max_abs_offset}};
+  j["method"] = r.method;
+  if (r.method == "nonlinear") {
+    const NonlinearStats& n = r.nonlinear;
+    j["nonlinear"] = {{"iterations", n.iterations},   {"total_iterations", n.total_iterations},
+                      {"accelerated", n.accelerated}, {"converged", n.converged},
+                      {"last_move", n.last_move},     {"energy", n.energy},
+                      {"fallback", r.fallback}};
+  }
   j["milliseconds"] = r.milliseconds;
   return j;
 }
