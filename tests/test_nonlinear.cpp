@@ -7,9 +7,11 @@
 #include <filesystem>
 #include <iostream>
 #include <numbers>
+#include <random>
 #include <vector>
 
 #include <Eigen/Geometry>
+#include <Eigen/SVD>
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
@@ -199,6 +201,35 @@ TEST(Nonlinear, TheCylinderKeepsItsRadiusAndBumpsWhenTwistedAndBent) {
   }
 }
 
+// A large support is previewed on a coarse remesh of the base while a handle is dragged: close to
+// the fine result and exact at the identity; the fine iteration takes over and converges.
+TEST(Nonlinear, TheCoarsePreviewIsCloseAndTheFineLevelTakesOver) {
+  const Cylinder c = bumpy_cylinder(48, 64);
+  EditorOptions o = nonlinear_options();
+  o.nonlinear.preview_vertices = 400;
+  Editor editor(c.mesh, o);
+  editor.set_region(c.support, {c.handle});
+  EXPECT_GT(editor.report().free_base_vertices, 800u);
+  const Eigen::MatrixXd input = positions_matrix(c.mesh);
+  // A drag: a frame's budget, then the fine level until converged.
+  editor.set_transform(0, twist(c, kPi / 2));
+  const Eigen::MatrixXd preview = editor.positions(1e-3);
+  EXPECT_EQ(editor.report().nonlinear_level, "coarse");
+  EXPECT_FALSE(editor.converged());
+  const Eigen::MatrixXd fine = editor.positions();
+  EXPECT_EQ(editor.report().nonlinear_level, "fine");
+  EXPECT_TRUE(editor.converged());
+  const double preview_error = rings(c, preview).worst_radius_error;
+  const double fine_error = rings(c, fine).worst_radius_error;
+  std::cout << "preview: radius error " << preview_error << " (fine " << fine_error
+            << "), largest distance to the fine result " << max_row_distance(preview, fine) << "\n";
+  EXPECT_LT(preview_error, 0.1);
+  EXPECT_LT(max_row_distance(preview, fine), 0.1);
+  // Exact cases through the preview.
+  editor.set_transform(0, identity_transform());
+  EXPECT_LT(max_row_distance(editor.positions(1e-3), input), 1e-10 * c.height);
+}
+
 TEST(Nonlinear, TheEnergyNeverIncreases) {
   const Cylinder c = bumpy_cylinder(24, 32);
   for (const int anderson : {0, 5}) {
@@ -373,6 +404,33 @@ TEST(NonlinearDeformer, ConvergesToTheSameShapeFromDifferentStarts) {
     results[start] = d.positions();
   }
   EXPECT_LT((results[0] - results[1]).rowwise().norm().maxCoeff(), 1e-6);
+}
+
+// The local step's rotation against the SVD's (the optimum of tr(R P)), from the identity, on
+// random full-rank and planar (rank 2) matrices; and never worse than its start.
+TEST(NonlinearDeformer, BestRotationMatchesTheSvdAndNeverLosesToItsStart) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  int close = 0;
+  for (int trial = 0; trial < 400; ++trial) {
+    Eigen::Matrix3d p;
+    for (int i = 0; i < 9; ++i) p(i / 3, i % 3) = u(rng);
+    if (trial % 2) p.col(2) = 0.3 * p.col(0) - 0.7 * p.col(1); // rank 2
+    const Eigen::JacobiSVD<Eigen::Matrix3d> svd(p, Eigen::ComputeFullU | Eigen::ComputeFullV);
+    Eigen::Matrix3d v = svd.matrixV();
+    if ((v * svd.matrixU().transpose()).determinant() < 0) v.col(2) = -v.col(2);
+    const double best = (v * svd.matrixU().transpose() * p).trace();
+    const Eigen::Matrix3d start =
+        Eigen::AngleAxisd(u(rng) * kPi, Eigen::Vector3d(u(rng), u(rng), u(rng)).normalized())
+            .toRotationMatrix();
+    const Eigen::Matrix3d r = best_rotation(p, start);
+    EXPECT_NEAR((r.transpose() * r - Eigen::Matrix3d::Identity()).norm(), 0.0, 1e-12);
+    EXPECT_NEAR(r.determinant(), 1.0, 1e-12);
+    EXPECT_GE((r * p).trace(), (start * p).trace() - 1e-12);
+    EXPECT_LE((r * p).trace(), best + 1e-12);
+    close += (r * p).trace() > best - 1e-9 ? 1 : 0;
+  }
+  EXPECT_GT(close, 385); // a few nearly degenerate draws need more than one call
 }
 
 TEST(NonlinearDeformer, RefusesMismatchedInput) {

@@ -18,6 +18,7 @@
 #include "remora/geometry/measures.h"
 #include "remora/multires/frame.h"
 #include "remora/multires/multigrid.h"
+#include "remora/multires/nonlinear_region.h"
 
 namespace remora {
 namespace {
@@ -48,17 +49,6 @@ DetailMode parse_detail_mode(const std::string& name) {
       fmt::format("unknown detail mode '{}': use normal (the paper), displacement or none", name));
 }
 
-std::string to_string(EditMethod method) {
-  return method == EditMethod::Linear ? "linear" : "nonlinear";
-}
-
-EditMethod parse_edit_method(const std::string& name) {
-  if (name == "linear") return EditMethod::Linear;
-  if (name == "nonlinear") return EditMethod::Nonlinear;
-  throw InvalidArgument(fmt::format(
-      "unknown method '{}': use linear (the paper) or nonlinear (large rotations)", name));
-}
-
 // ---- the editor ------------------------------------------------------------------------------
 
 namespace {
@@ -82,10 +72,7 @@ struct RegionState {
   Eigen::MatrixXd current_positions;
   std::vector<double> face_normals; // update_normals()'s scratch
   bool dirty = true;
-  // Method nonlinear (multires/nonlinear.h): null when building it failed (deformer_error says
-  // why; the frames then show the linear result).
-  std::unique_ptr<NonlinearDeformer> deformer;
-  std::string deformer_error, fallback;
+  std::unique_ptr<NonlinearRegion> nonlinear; // method nonlinear (multires/nonlinear_region.h)
 };
 
 } // namespace
@@ -102,6 +89,7 @@ struct Editor::Impl {
   std::vector<SurfacePoint> base_on_input, input_on_base;
   std::vector<std::pair<int, int>> negative_edges; // of B
   std::unique_ptr<MultigridSolver> multigrid;
+  std::unique_ptr<RemeshResult> coarse; // method nonlinear's preview level, for every region
   EditReport report;
   std::unique_ptr<RegionState> region;
 
@@ -117,7 +105,7 @@ struct Editor::Impl {
     return *region;
   }
   void update(double budget_ms);
-  void build_deformer(RegionState& r);
+  void build_nonlinear(RegionState& r);
   void deform_base(RegionState& r, bool moved, double budget_ms);
 
   // The steps of set_region(), in order, on a new state (the current region stays until all
@@ -476,10 +464,10 @@ void Editor::Impl::find_affected(RegionState& r) const {
   r.affected = plan_normals(topology, vertices);
 }
 
-// Method nonlinear: the deformer from B0, the labels and the handles' scalar weights (the basis
-// functions' "1" columns). A failure leaves the linear method in place, with the reason.
-void Editor::Impl::build_deformer(RegionState& r) {
-  if (options.method != EditMethod::Nonlinear) return;
+// Method nonlinear: its deformers from B0, the labels and the handles' scalar weights (the basis
+// functions' "1" columns); for a large support the coarse base of its preview, made once and
+// kept while the regions' sizes call for about the same coarse edge length.
+void Editor::Impl::build_nonlinear(RegionState& r) {
   const auto t0 = Clock::now();
   Eigen::MatrixXd weights = Eigen::MatrixXd::Zero(r.rest.rows(), r.handles);
   for (std::size_t row = 0; row < r.free_vertices.size(); ++row)
@@ -490,40 +478,32 @@ void Editor::Impl::build_deformer(RegionState& r) {
     for (const int v : r.handle_base[static_cast<std::size_t>(j)]) weights(v, j) = 1.0;
   NonlinearOptions o = options.nonlinear;
   o.threads = options.threads;
-  try {
-    r.deformer = std::make_unique<NonlinearDeformer>(base, r.rest, r.base_label, weights, o);
-  } catch (const Error& e) {
-    r.deformer_error = fmt::format("the nonlinear method is off for this region ({}); the "
-                                   "linear result is shown",
-                                   e.what());
+  const std::size_t n_free = r.free_vertices.size();
+  const bool preview =
+      o.preview_vertices > 0 && n_free > 2 * static_cast<std::size_t>(o.preview_vertices);
+  if (preview) {
+    const double wanted = coarse_length(mean_edge_length(base), n_free, o);
+    if (!coarse || std::abs(mean_edge_length(coarse->mesh) / wanted - 1.0) > 0.5) {
+      const auto t1 = Clock::now();
+      coarse = std::make_unique<RemeshResult>(make_coarse_base(base, n_free, o));
+      report.milliseconds["nonlinear coarse base"] = ms_since(t1);
+    }
   }
+  r.nonlinear = std::make_unique<NonlinearRegion>(base, preview ? coarse.get() : nullptr, r.rest,
+                                                  r.base_label, weights, o);
   report.milliseconds["nonlinear setup"] = ms_since(t0);
 }
 
-// Method nonlinear, in a frame: r.current_base holds the blend (the linear result); the deformer
-// replaces its free rows, or the blend stays with a message when the iteration fails.
+// Method nonlinear, in a frame: r.current_base holds the blend (the linear result); the region's
+// nonlinear state replaces its free rows, or leaves the blend with a message.
 void Editor::Impl::deform_base(RegionState& r, bool moved, double budget_ms) {
-  if (!r.deformer && r.deformer_error.empty()) build_deformer(r); // after set_method()
+  if (!r.nonlinear) build_nonlinear(r); // after set_method()
   const auto t0 = Clock::now();
+  r.nonlinear->frame(r.transforms, moved, budget_ms, r.current_base);
   report.method = "nonlinear";
-  if (moved) r.fallback.clear();
-  if (!r.deformer) {
-    r.fallback = r.deformer_error;
-  } else if (r.fallback.empty()) {
-    try {
-      if (moved) r.deformer->set_transforms(r.transforms, &r.current_base);
-      report.nonlinear = r.deformer->solve(budget_ms);
-      const RowPoints& x = r.deformer->positions();
-      for (const int v : r.free_vertices)
-        if (!x.row(v).allFinite())
-          throw NumericalError("the iteration produced a non-finite position");
-      for (const int v : r.free_vertices) r.current_base.row(v) = x.row(v);
-    } catch (const Error& e) {
-      r.fallback =
-          fmt::format("the nonlinear iteration failed ({}); the linear result is shown", e.what());
-    }
-  }
-  report.fallback = r.fallback;
+  report.nonlinear = r.nonlinear->stats();
+  report.nonlinear_level = r.nonlinear->level();
+  report.fallback = r.nonlinear->fallback();
   report.milliseconds["frame nonlinear"] = ms_since(t0);
 }
 
@@ -538,7 +518,7 @@ void Editor::set_region(const std::vector<int>& support,
   m.solve_basis(r);
   m.encode_details(r);
   m.find_affected(r);
-  m.build_deformer(r);
+  if (m.options.method == EditMethod::Nonlinear) m.build_nonlinear(r);
   r.transforms.assign(static_cast<std::size_t>(r.handles), identity_transform());
   r.current_base = r.rest;
   r.current_normals = r.rest_normals;
@@ -576,7 +556,6 @@ void Editor::set_method(EditMethod method) {
   Impl& m = *impl_;
   m.options.method = method;
   if (!m.region) return;
-  m.region->fallback.clear();
   m.region->dirty = true;
 }
 
@@ -613,7 +592,8 @@ const Transform& Editor::transform(int handle) const {
 
 void Editor::Impl::update(double budget_ms) {
   RegionState& r = state();
-  const bool iterating = r.deformer && r.fallback.empty() && !r.deformer->stats().finished();
+  const bool iterating =
+      options.method == EditMethod::Nonlinear && r.nonlinear && !r.nonlinear->finished();
   if (!r.dirty && !iterating) return;
   const auto t0 = Clock::now();
   // Blend: X_free = Φ_0 + Σ_j Φ_j [M_jᵀ; t_jᵀ].
@@ -673,8 +653,8 @@ const Eigen::MatrixXd& Editor::positions(double budget_ms) {
 
 bool Editor::converged() const {
   const RegionState* r = impl_->region.get();
-  if (!r || !r->deformer || !r->fallback.empty()) return true;
-  return !r->dirty && r->deformer->stats().finished();
+  if (!r || impl_->options.method == EditMethod::Linear) return true;
+  return !r->dirty && r->nonlinear && r->nonlinear->finished();
 }
 
 Mesh Editor::result() {

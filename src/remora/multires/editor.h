@@ -67,14 +67,6 @@ enum class DetailMode {
 std::string to_string(DetailMode mode);
 DetailMode parse_detail_mode(const std::string& name); ///< "normal", "displacement", "none"
 
-/// How the base deforms under the handles' maps.
-enum class EditMethod {
-  Linear,    ///< the blend of the k-harmonic basis functions (the paper; exact for affine maps)
-  Nonlinear, ///< multires/nonlinear.h from B0, warm-started by the blend (large rotations)
-};
-std::string to_string(EditMethod method);
-EditMethod parse_edit_method(const std::string& name); ///< "linear", "nonlinear"
-
 struct EditorOptions {
   LowPassOptions base;                ///< the base surface's low-pass filter
   bool remesh = true;                 ///< false: the "no remesh" baseline on O's own connectivity
@@ -123,6 +115,9 @@ struct EditReport {
   /// The base's deformation in the last frame: "linear" or "nonlinear".
   std::string method = "linear";
   NonlinearStats nonlinear; ///< method nonlinear: the last frame's iterations
+  /// Method nonlinear: "coarse" when the last frame showed the preview of a large support,
+  /// "fine" otherwise (multires/nonlinear_region.h).
+  std::string nonlinear_level;
   /// Method nonlinear: why the last frame shows the linear result instead (empty otherwise).
   std::string fallback;
   /// Wall time in milliseconds: "base", "remesh", "set_region" (and its parts "assemble",

@@ -1,10 +1,12 @@
 #include "remora/multires/nonlinear.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 
 #include <Eigen/Dense>
+#include <Eigen/Geometry>
 #include <Eigen/SVD>
 #include <fmt/format.h>
 
@@ -21,8 +23,9 @@ namespace {
 using Matrix3 = Eigen::Matrix3d;
 using Vector3 = Eigen::Vector3d;
 
-/// The rotation R maximizing tr(R P) (orthogonal Procrustes; Sorkine & Alexa 2007, Eq. 6).
-Matrix3 best_rotation(const Matrix3& p) {
+/// The rotation R maximizing tr(R P) by SVD (orthogonal Procrustes; Sorkine & Alexa 2007,
+/// Eq. 6): the fallback of best_rotation().
+Matrix3 best_rotation_svd(const Matrix3& p) {
   const Eigen::JacobiSVD<Matrix3> svd(p, Eigen::ComputeFullU | Eigen::ComputeFullV);
   Matrix3 v = svd.matrixV();
   Matrix3 r = v * svd.matrixU().transpose();
@@ -46,6 +49,48 @@ bool is_identity(const AffineMap& t) {
 }
 
 } // namespace
+
+// tr(R(q) P) = qᵀ N q for unit quaternions q (Horn 1987, §4 with P = Σ p qᵀ, rest times current):
+// the best rotation is the eigenvector of N's largest eigenvalue. N + c I with c >= ‖N‖₂ (c =
+// √3 ‖P‖_F bounds the nuclear norm of P, hence every |λ(N)|) is positive semi-definite, and the
+// Rayleigh quotient of a PSD matrix does not decrease under multiplication by it, so
+// (N + c I)^256 q₀ (eight squarings) is at least as good as the start q₀ and converges to the
+// best (in one call unless N's two largest eigenvalues nearly coincide; the iteration's next
+// local step goes on from there).
+Eigen::Matrix3d best_rotation(const Eigen::Matrix3d& p, const Eigen::Matrix3d& start) {
+  const double sxx = p(0, 0), sxy = p(0, 1), sxz = p(0, 2), syx = p(1, 0), syy = p(1, 1),
+               syz = p(1, 2), szx = p(2, 0), szy = p(2, 1), szz = p(2, 2);
+  Eigen::Matrix4d n;
+  n << sxx + syy + szz, syz - szy, szx - sxz, sxy - syx, //
+      syz - szy, sxx - syy - szz, sxy + syx, szx + sxz,  //
+      szx - sxz, sxy + syx, -sxx + syy - szz, syz + szy, //
+      sxy - syx, szx + sxz, syz + szy, -sxx - syy + szz;
+  const double scale = std::sqrt(3.0) * p.norm();
+  if (!(scale > 0.0) || !std::isfinite(scale)) return start;
+  n /= scale;
+  n.diagonal().array() += 1.0;
+  for (int k = 0; k < 8; ++k) {
+    n = (n * n).eval();
+    n /= n.cwiseAbs().maxCoeff();
+  }
+  const Eigen::Quaterniond q0(start);
+  Eigen::Vector4d q = n * Eigen::Vector4d(q0.w(), q0.x(), q0.y(), q0.z());
+  const double length = q.norm();
+  if (!(length > 1e-150) || !std::isfinite(length)) return best_rotation_svd(p);
+  q /= length;
+  return Eigen::Quaterniond(q[0], q[1], q[2], q[3]).toRotationMatrix();
+}
+
+std::string to_string(EditMethod method) {
+  return method == EditMethod::Linear ? "linear" : "nonlinear";
+}
+
+EditMethod parse_edit_method(const std::string& name) {
+  if (name == "linear") return EditMethod::Linear;
+  if (name == "nonlinear") return EditMethod::Nonlinear;
+  throw InvalidArgument(fmt::format(
+      "unknown method '{}': use linear (the paper) or nonlinear (large rotations)", name));
+}
 
 std::string to_string(NonlinearEnergy energy) {
   return energy == NonlinearEnergy::Arap ? "arap" : "rotated-laplacian";
@@ -122,25 +167,38 @@ struct NonlinearDeformer::Impl {
                       : Vector3(delta.row(static_cast<Eigen::Index>(c)).transpose());
         p += a * d * r.transpose();
       }
-      for (int k = ring_begin[c]; k < ring_begin[c + 1]; ++k) {
+      // The ring's current and rest edges, kept for the energy (a ring longer than the buffer
+      // computes them again).
+      constexpr int kBuffer = 24;
+      std::array<Vector3, kBuffer> es, e0s;
+      const auto edge = [&](int k, Vector3& e, Vector3& e0) {
         const int j = ring_vertex[static_cast<std::size_t>(k)];
-        const double w = ring_weight[static_cast<std::size_t>(k)];
-        const Vector3 e = (x.row(m) - x.row(j)).transpose();
-        Vector3 e0 = (rest.row(m) - rest.row(j)).transpose();
+        e = (x.row(m) - x.row(j)).transpose();
+        e0 = (rest.row(m) - rest.row(j)).transpose();
         if (stretched) e0 = s * e0;
-        p += beta * w * e0 * e.transpose();
+      };
+      for (int k = ring_begin[c]; k < ring_begin[c + 1]; ++k) {
+        Vector3 e, e0;
+        edge(k, e, e0);
+        if (k - ring_begin[c] < kBuffer) {
+          es[static_cast<std::size_t>(k - ring_begin[c])] = e;
+          e0s[static_cast<std::size_t>(k - ring_begin[c])] = e0;
+        }
+        p += (beta * ring_weight[static_cast<std::size_t>(k)]) * e0 * e.transpose();
       }
-      const Matrix3 rot = best_rotation(p);
+      const Matrix3 rot = best_rotation(p, rotation[c]);
       out[c] = rot;
       double energy = 0.0;
       if (a > 0.0) energy += a * (r - rot * d).squaredNorm();
       for (int k = ring_begin[c]; k < ring_begin[c + 1]; ++k) {
-        const int j = ring_vertex[static_cast<std::size_t>(k)];
-        const double w = ring_weight[static_cast<std::size_t>(k)];
-        const Vector3 e = (x.row(m) - x.row(j)).transpose();
-        Vector3 e0 = (rest.row(m) - rest.row(j)).transpose();
-        if (stretched) e0 = s * e0;
-        energy += beta * w * (e - rot * e0).squaredNorm();
+        Vector3 e, e0;
+        if (k - ring_begin[c] < kBuffer) {
+          e = es[static_cast<std::size_t>(k - ring_begin[c])];
+          e0 = e0s[static_cast<std::size_t>(k - ring_begin[c])];
+        } else {
+          edge(k, e, e0);
+        }
+        energy += beta * ring_weight[static_cast<std::size_t>(k)] * (e - rot * e0).squaredNorm();
       }
       cell_energy[c] = energy;
     });

@@ -45,6 +45,14 @@ namespace remora {
 /// An affine map x -> M x + t as the 3×4 matrix [M | t] (also multires/editor.h's Transform).
 using AffineMap = Eigen::Matrix<double, 3, 4>;
 
+/// How the editor deforms the base under the handles' maps (multires/editor.h).
+enum class EditMethod {
+  Linear,    ///< the blend of the k-harmonic basis functions (the paper; exact for affine maps)
+  Nonlinear, ///< this file's deformation from B0, warm-started by the blend (large rotations)
+};
+std::string to_string(EditMethod method);
+EditMethod parse_edit_method(const std::string& name); ///< "linear", "nonlinear"
+
 enum class NonlinearEnergy { Arap, RotatedLaplacian };
 
 struct NonlinearOptions {
@@ -59,7 +67,11 @@ struct NonlinearOptions {
   double tolerance = 1e-4;
   int anderson = 5;     ///< Anderson history length; 0 = plain local/global iterations
   SolverOptions solver; ///< the global step's factorization (empty name: the default)
-  int threads = 0;      ///< 0 = all
+  /// The editor: a support of more than twice this many free base vertices is previewed while
+  /// dragging on a coarse remesh of the base with about this many (multires/nonlinear_region.h);
+  /// 0 = never.
+  int preview_vertices = 4000;
+  int threads = 0; ///< 0 = all
 };
 
 struct NonlinearStats {
@@ -104,6 +116,11 @@ private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
+
+/// The local step's rotation: R maximizing tr(R P) (orthogonal Procrustes), improved from
+/// `start` by power iterations on Horn's quaternion matrix (1987): never worse than `start`, the
+/// best rotation to round-off unless P is nearly degenerate (then it is still no worse).
+Eigen::Matrix3d best_rotation(const Eigen::Matrix3d& p, const Eigen::Matrix3d& start);
 
 std::string to_string(NonlinearEnergy energy);
 NonlinearEnergy parse_nonlinear_energy(const std::string& name); ///< "arap", "rotated-laplacian"
