@@ -54,9 +54,9 @@ bool is_identity(const AffineMap& t) {
 // the best rotation is the eigenvector of N's largest eigenvalue. N + c I with c >= ‖N‖₂ (c =
 // √3 ‖P‖_F bounds the nuclear norm of P, hence every |λ(N)|) is positive semi-definite, and the
 // Rayleigh quotient of a PSD matrix does not decrease under multiplication by it, so
-// (N + c I)^256 q₀ (eight squarings) is at least as good as the start q₀ and converges to the
-// best (in one call unless N's two largest eigenvalues nearly coincide; the iteration's next
-// local step goes on from there).
+// (N + c I)^(2^k) q₀ is at least as good as the start q₀ and converges to the best: up to eight
+// squarings, fewer once q is an eigenvector to round-off (a warm start). One call reaches the best
+// unless N's two largest eigenvalues nearly coincide; the iteration's next local step goes on.
 Eigen::Matrix3d best_rotation(const Eigen::Matrix3d& p, const Eigen::Matrix3d& start) {
   const double sxx = p(0, 0), sxy = p(0, 1), sxz = p(0, 2), syx = p(1, 0), syy = p(1, 1),
                syz = p(1, 2), szx = p(2, 0), szy = p(2, 1), szz = p(2, 2);
@@ -69,15 +69,22 @@ Eigen::Matrix3d best_rotation(const Eigen::Matrix3d& p, const Eigen::Matrix3d& s
   if (!(scale > 0.0) || !std::isfinite(scale)) return start;
   n /= scale;
   n.diagonal().array() += 1.0;
+  const Eigen::Matrix4d shifted = n;
+  const Eigen::Quaterniond q0(start);
+  const Eigen::Vector4d start_q(q0.w(), q0.x(), q0.y(), q0.z());
+  Eigen::Vector4d q = start_q;
   for (int k = 0; k < 8; ++k) {
     n = (n * n).eval();
     n /= n.cwiseAbs().maxCoeff();
+    if (k % 2 == 0) continue;
+    // Every second squaring: done when q is an eigenvector to round-off (a warm start).
+    q = n * start_q;
+    const double length = q.norm();
+    if (!(length > 1e-150) || !std::isfinite(length)) return best_rotation_svd(p);
+    q /= length;
+    const Eigen::Vector4d nq = shifted * q;
+    if ((nq - q.dot(nq) * q).norm() < 1e-13) break;
   }
-  const Eigen::Quaterniond q0(start);
-  Eigen::Vector4d q = n * Eigen::Vector4d(q0.w(), q0.x(), q0.y(), q0.z());
-  const double length = q.norm();
-  if (!(length > 1e-150) || !std::isfinite(length)) return best_rotation_svd(p);
-  q /= length;
   return Eigen::Quaterniond(q[0], q[1], q[2], q[3]).toRotationMatrix();
 }
 
@@ -128,7 +135,9 @@ struct NonlinearDeformer::Impl {
   // Anderson history: columns of differences of G values and residuals.
   Eigen::MatrixXd dg, df;
   Eigen::VectorXd last_g, last_f;
-  Eigen::VectorXd previous_guess; // the free rows of the last guess (x⁰ at first)
+  Eigen::VectorXd previous_guess;                 // the free rows of the last guess (x⁰ at first)
+  int plain_steps = 0;                            // iterations left without an extrapolation
+  std::array<double, 3> decreases{0.0, 0.0, 0.0}; // of E in the last three iterations
   int history = 0;
 
   std::size_t nf() const { return free_vertices.size(); }
@@ -400,13 +409,18 @@ Eigen::VectorXd NonlinearDeformer::Impl::anderson(const Eigen::VectorXd& g,
 
 void NonlinearDeformer::Impl::iterate() {
   const Eigen::VectorXd u = free_vector();
+  const double before = current_energy;
   const Eigen::VectorXd g = global_step(rotation);
   const Eigen::VectorXd f = g - u;
   std::vector<Matrix3> rot(cells.size());
   bool accepted = false;
   if (options.anderson > 0) {
     const Eigen::VectorXd candidate = anderson(g, f);
-    if (history > 0 && candidate.allFinite()) {
+    // After a rejected extrapolation the next two iterations are plain (each test costs a local
+    // step).
+    if (plain_steps > 0) {
+      --plain_steps;
+    } else if (history > 0 && candidate.allFinite()) {
       set_free(candidate);
       const double e = local_step(rot);
       if (e < current_energy) {
@@ -415,6 +429,7 @@ void NonlinearDeformer::Impl::iterate() {
         ++stats.accelerated;
       } else { // keep only the newest point
         history = 0;
+        plain_steps = 2;
       }
     }
   }
@@ -427,7 +442,11 @@ void NonlinearDeformer::Impl::iterate() {
   stats.energy.push_back(current_energy);
   ++stats.iterations;
   ++stats.total_iterations;
-  stats.converged = stats.last_move < options.tolerance;
+  decreases[static_cast<std::size_t>(stats.total_iterations % 3)] = before - current_energy;
+  const double recent = decreases[0] + decreases[1] + decreases[2];
+  stats.converged =
+      stats.last_move < options.tolerance ||
+      (stats.total_iterations >= 3 && recent <= 3.0 * options.energy_tolerance * current_energy);
   stats.exhausted = !stats.converged && stats.total_iterations >= options.max_iterations;
 }
 
@@ -447,9 +466,9 @@ NonlinearDeformer::NonlinearDeformer(const Mesh& base, const Eigen::MatrixXd& re
   if (!rest.allFinite() || !handle_weights.allFinite())
     throw InvalidArgument("nonlinear deformer: a rest position or weight is not finite");
   if (!(options.rigidity > 0.0) || options.max_iterations < 1 || !(options.tolerance > 0.0) ||
-      options.anderson < 0)
+      !(options.energy_tolerance >= 0.0) || options.anderson < 0)
     throw InvalidArgument("nonlinear deformer: rigidity and tolerance must be > 0, "
-                          "max_iterations >= 1 and anderson >= 0");
+                          "energy_tolerance >= 0, max_iterations >= 1 and anderson >= 0");
   m.options = options;
   m.labels = labels;
   m.weights = handle_weights;
@@ -478,6 +497,8 @@ void NonlinearDeformer::set_transforms(const std::vector<AffineMap>& transforms,
                                       transforms.size(), handles));
   m.stats = NonlinearStats{};
   m.history = 0;
+  m.plain_steps = 0;
+  m.decreases = {0.0, 0.0, 0.0};
   m.last_g.resize(0);
   m.identity = std::all_of(transforms.begin(), transforms.end(), is_identity);
   if (m.identity) { // E = 0 at x⁰: the minimizer, exactly

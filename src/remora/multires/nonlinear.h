@@ -63,8 +63,10 @@ struct NonlinearOptions {
   double rigidity = 100.0;
   int max_iterations = 200; ///< since the last set_transforms()
   /// Converged when the largest move of a free vertex in an iteration is below this times the
-  /// base's mean edge length.
+  /// base's mean edge length, or when E fell by less than energy_tolerance × E per iteration over
+  /// the last three.
   double tolerance = 1e-4;
+  double energy_tolerance = 1e-4;
   int anderson = 5;     ///< Anderson history length; 0 = plain local/global iterations
   SolverOptions solver; ///< the global step's factorization (empty name: the default)
   /// The editor: a support of more than twice this many free base vertices is previewed while
