@@ -34,7 +34,7 @@ const { orbit, gizmo, pivot } = view;
 // ---- state --------------------------------------------------------------------------------------
 const MIN_SCALE = 0.05; // the manipulator's smallest scale per axis: the map keeps det(M) > 0
 const state = {
-  tool: 'orbit', selected: 0, handleCount: 1, k: 2,
+  tool: 'orbit', selected: 0, handleCount: 1, k: 2, method: 'linear', converged: true,
   labels: null, positions: null, indices: null, // labels: FIXED, FREE or a handle index per vertex
   movable: null, sentMovable: null, serverHandles: 0, transforms: [], dirtyRegion: false, status: null, frameMs: undefined,
   held: { mesh: undefined, positions: undefined, region: undefined }, // the status ids of what the page holds
@@ -92,6 +92,8 @@ async function fetchRegion(s, labelsKnown) {
       region.handles.forEach((h, j) => { for (const v of h) state.labels[v] = j; });
       state.k = region.k;
       panels.setK(region.k);
+      state.method = region.method ?? 'linear';
+      panels.setMethod(state.method);
     }
     state.handleCount = Math.max(1, region?.handles.length ?? 0);
     state.selected = Math.min(state.selected, state.handleCount - 1);
@@ -222,6 +224,8 @@ function regionLists() {
 let regionSeq = 0;
 async function sendRegion({ keepGizmo = false, inStroke = false } = {}) {
   const started = performance.now(), seq = ++regionSeq;
+  clearTimeout(relaxTimer);
+  relaxTimer = null;
   state.dirtyRegion = false;
   const { support, handles, free } = regionLists();
   showHandleButtons();
@@ -236,7 +240,7 @@ async function sendRegion({ keepGizmo = false, inStroke = false } = {}) {
   }
   if (busy() && state.status?.progress?.job !== 'region') await settle(); // a load: wait for it
   const steps = { started, lists: performance.now() };
-  const posted = post('region', { support, handles, k: state.k });
+  const posted = post('region', { support, handles, k: state.k, method: state.method });
   // While the request travels and the server solves: the normal plan of the region sent (its
   // movable vertices are the support, handles included, sorted).
   state.sentMovable = Uint32Array.from(support);
@@ -339,19 +343,49 @@ function matrixToRows(m) {
   return [e[0], e[4], e[8], e[12], e[1], e[5], e[9], e[13], e[2], e[6], e[10], e[14]];
 }
 
+// A frame: a handle's new map (POST transform), or for the nonlinear method more iterations under
+// the same maps while the pointer rests (POST relax). The answer is the movable vertices' positions.
+const RELAX_PAUSE_MS = 120, RELAX_BUDGET_MS = 40;
 async function sendFrame(request) {
-  const response = await api('transform', { method: 'POST', headers: { 'Content-Type': 'application/json' },
-                                            body: JSON.stringify({ handle: request.handle, matrix: request.matrix }) });
+  // A refused relax (the server busy with a new region) is dropped without a message.
+  const response = request.relax
+    ? await fetch('api/relax', { method: 'POST', headers: { 'Content-Type': 'application/json' },
+                                 body: JSON.stringify({ budget_ms: RELAX_BUDGET_MS }) })
+    : await api('transform', { method: 'POST', headers: { 'Content-Type': 'application/json' },
+                               body: JSON.stringify({ handle: request.handle, matrix: request.matrix }) });
+  if (!response.ok) throw new ApiError(response.status, 'relax refused');
   const buffer = await response.arrayBuffer();
-  return { moved: new Float32Array(buffer), bytes: buffer.byteLength, ms: parseFloat(response.headers.get('X-Frame-Ms')) };
+  return { moved: new Float32Array(buffer), bytes: buffer.byteLength, ms: parseFloat(response.headers.get('X-Frame-Ms')),
+           converged: response.headers.get('X-Converged') !== '0' };
 }
+let lastMove = 0, relaxTimer = null;
 const frames = new Coalescer(sendFrame, (result, request) => {
   if (!state.movable || result.moved.length !== 3 * state.movable.length) return;
   state.frameMs = result.ms;
   view.applyMoved(state.movable, result.moved);
-  state.marks.drag.push(performance.now() - request.t0);
-  state.marks.dragBytes.push(result.bytes);
+  if (!request.relax) {
+    state.marks.drag.push(performance.now() - request.t0);
+    state.marks.dragBytes.push(result.bytes);
+  }
+  state.converged = result.converged;
+  if (!result.converged) relaxSoon();
+  else if (request.relax) task(refreshStatus);
 });
+/// While the nonlinear iteration is not converged: once the pointer has rested RELAX_PAUSE_MS,
+/// ask for more iterations (a newer move replaces a waiting relax request).
+function relaxSoon() {
+  clearTimeout(relaxTimer);
+  const wait = Math.max(0, lastMove + RELAX_PAUSE_MS - performance.now());
+  relaxTimer = setTimeout(() => {
+    relaxTimer = null;
+    if (!frames.pending && performance.now() - lastMove >= RELAX_PAUSE_MS) frames.submit({ relax: true });
+    else if (!frames.pending) relaxSoon();
+  }, wait);
+}
+async function refreshStatus() {
+  try { state.status = await json('status'); panels.showStats(state.status, state.frameMs); } catch (e) { /* shown */ }
+  if (state.status?.nonlinear?.fallback) message(state.status.nonlinear.fallback, 'hint');
+}
 
 let dragStart = null, dragBase = null;
 gizmo.addEventListener('dragging-changed', (event) => {
@@ -376,7 +410,8 @@ gizmo.addEventListener('objectChange', () => {
   pivot.updateMatrix();
   const t = pivot.matrix.clone().multiply(dragStart).multiply(dragBase);
   state.transforms[state.selected] = t;
-  frames.submit({ handle: state.selected, matrix: matrixToRows(t), t0: performance.now() });
+  lastMove = performance.now();
+  frames.submit({ handle: state.selected, matrix: matrixToRows(t), t0: lastMove });
 });
 
 // ---- the base surface ---------------------------------------------------------------------------
@@ -425,6 +460,10 @@ function setK(k) {
   state.k = k;
   if (state.movable && state.labels && !painting) task(() => sendRegion({ keepGizmo: true }));
 }
+function setMethod(method) {
+  state.method = method;
+  if (state.movable && state.labels && !painting) task(() => sendRegion({ keepGizmo: true }));
+}
 async function history(which) {
   if (busy() || frames.busy || painting) return;
   message('');
@@ -443,7 +482,7 @@ async function upload(file) {
   message(`Loaded ${file.name}. Paint a support (S), then a handle inside it (H).`, 'info');
 }
 panels.bindPanels({
-  setTool, setMode, newHandle, clear, setK, showMesh,
+  setTool, setMode, newHandle, clear, setK, setMethod, showMesh,
   history: (which) => task(() => history(which)),
   showBase: () => task(() => showBase(false)),
   upload: (file) => task(() => upload(file)),
@@ -494,7 +533,10 @@ window.remora = {
     for (let i = 0; i < n.length; i += 3) worst = Math.max(worst, 1 - Math.max(Math.abs(n[i]), Math.abs(n[i + 1]), Math.abs(n[i + 2])));
     return worst;
   },
-  ready: () => !!view.shown.mesh && work.tasks === 0 && !frames.busy && !picks.busy && state.status?.state === 'ready',
+  ready: () => !!view.shown.mesh && work.tasks === 0 && !frames.busy && relaxTimer === null && !picks.busy &&
+               state.status?.state === 'ready',
+  converged: () => state.converged,
+  method: () => state.method,
   setTool, setMode,
 };
 

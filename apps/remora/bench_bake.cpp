@@ -178,7 +178,7 @@ nlohmann::json session_bakes(const BenchBakeArgs& a, int bakes) {
                     {"rss_mb", static_cast<double>(resident_kb()) / 1024.0},
                     {"status", status["base"]}});
     const double s = (i % 2 == 0 ? 1.0 : -1.0) * a.move * bounding_box_diagonal(mesh);
-    session.set_transform(0, translation(Eigen::Vector3d(0, s, 0)), nullptr);
+    session.set_transform(0, translation(Eigen::Vector3d(0, s, 0)));
     session.commit();
   }
   return rows;

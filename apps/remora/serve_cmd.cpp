@@ -34,7 +34,7 @@ void add_serve_command(CLI::App& app) {
   struct Args {
     std::string mesh, host = "127.0.0.1", web_root = REMORA_WEB_ROOT;
     int port = 8080, threads = 0;
-    double max_upload_mb = 256;
+    double max_upload_mb = 256, frame_budget_ms = 6.0;
   };
   auto a = std::make_shared<Args>();
   cmd->add_option("mesh", a->mesh, "Mesh to load at start (.obj .off .ply .stl)");
@@ -46,6 +46,9 @@ void add_serve_command(CLI::App& app) {
       ->check(CLI::PositiveNumber);
   cmd->add_option("--threads", a->threads, "Editor threads (default: all)")
       ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--frame-budget", a->frame_budget_ms,
+                  "Method nonlinear: milliseconds of iterations per handle move (default 6)")
+      ->check(CLI::PositiveNumber);
   cmd->callback([a] {
     if (!std::filesystem::exists(std::filesystem::path(a->web_root) / "index.html"))
       throw InvalidArgument(fmt::format(
@@ -54,6 +57,7 @@ void add_serve_command(CLI::App& app) {
           a->web_root));
     server::SessionOptions options;
     options.threads = a->threads;
+    options.frame_budget_ms = a->frame_budget_ms;
     server::Session session(options);
     server::ApiLimits limits;
     limits.max_upload_bytes = static_cast<std::size_t>(a->max_upload_mb * 1024 * 1024);

@@ -23,6 +23,7 @@ struct RegionKey {
   std::vector<int> support;
   std::vector<std::vector<int>> handles;
   int k = 2;
+  EditMethod method = EditMethod::Linear;
   bool operator==(const RegionKey&) const = default;
 };
 
@@ -40,6 +41,16 @@ struct Snapshot {
   std::optional<RegionKey> region;
   std::vector<Transform> transforms;
 };
+
+/// The movable vertices' rows of `p` as interleaved Float32.
+std::vector<float> movable_floats(const Editor& editor, const Eigen::MatrixXd& p) {
+  const std::vector<int>& movable = editor.movable_vertices();
+  std::vector<float> out(3 * movable.size());
+  for (std::size_t i = 0; i < movable.size(); ++i)
+    for (int c = 0; c < 3; ++c)
+      out[3 * i + static_cast<std::size_t>(c)] = static_cast<float>(p(movable[i], c));
+  return out;
+}
 
 bool is_identity(const std::vector<Transform>& transforms) {
   for (const Transform& t : transforms)
@@ -127,6 +138,7 @@ struct Session::Impl {
     transforms = s.transforms;
     if (region && box->region != region) {
       box->editor.set_system({region->k, box->editor.options().system.areas});
+      box->editor.set_method(region->method);
       box->editor.set_region(region->support, region->handles);
       box->region = region;
     }
@@ -222,33 +234,55 @@ struct Session::Impl {
   /// A region job: the bake when a handle moved, the region prepared, then installed unless a
   /// newer region stopped the job (that one runs next and installs its own): a stopped job
   /// changes nothing.
-  void region_job(const RegionKey& key, bool bake, bool new_k,
-                  const std::shared_ptr<EditorBox>& current, const std::vector<Transform>& moved_by,
-                  const std::stop_token& token) {
+  /// What a region job does: bake first (a handle moved and the paint changed), solve the same
+  /// paint again under the same transforms (k or the method changed), set a new region (the
+  /// paint or k changed).
+  struct RegionWork {
+    bool bake, resolve, new_region;
+  };
+  void region_job(const RegionKey& key, RegionWork work, const std::shared_ptr<EditorBox>& current,
+                  const std::vector<Transform>& moved_by, const std::stop_token& token) {
     {
       std::lock_guard lock(mutex);
       span_begin = 0.0;
-      span_end = bake ? 0.85 : 0.0;
+      span_end = work.bake ? 0.85 : 0.0;
     }
-    const std::shared_ptr<EditorBox> next = bake ? bake_once(current, moved_by) : current;
+    const std::shared_ptr<EditorBox> next = work.bake ? bake_once(current, moved_by) : current;
     {
       std::lock_guard lock(mutex);
       report("set_region", 0, 1);
     }
-    // On a copy of the key: a failure leaves the session as it was.
-    const KHarmonicOptions system{key.k, next->editor.options().system.areas};
-    next->editor.set_system(system);
-    Editor::Prepared prepared = next->editor.prepare_region(key.support, key.handles, token);
+    // The method and k are the editor's options for set_region; a failed or stopped job puts
+    // them back, so that it leaves the session as it was.
+    Editor& editor = next->editor;
+    const KHarmonicOptions previous_system = editor.options().system;
+    const EditMethod previous_method = editor.options().method;
+    const auto restore = [&] {
+      editor.set_system(previous_system);
+      editor.set_method(previous_method);
+    };
+    std::optional<Editor::Prepared> prepared;
+    try {
+      editor.set_system({key.k, previous_system.areas});
+      editor.set_method(key.method);
+      if (work.new_region) prepared = editor.prepare_region(key.support, key.handles, token);
+    } catch (...) {
+      restore();
+      throw;
+    }
     std::lock_guard lock(mutex);
-    if (token.stop_requested()) return; // stale: the newer region is queued
-    next->editor.install_region(std::move(prepared));
+    if (token.stop_requested()) { // stale: the newer region is queued
+      restore();
+      return;
+    }
+    if (prepared) editor.install_region(std::move(*prepared));
     next->region = key;
     box = next;
     region = key;
     baked.reset();
     baked_from.reset();
     ++region_id;
-    if (new_k) {
+    if (work.resolve) {
       for (std::size_t j = 0; j < moved_by.size(); ++j)
         box->editor.set_transform(static_cast<int>(j), moved_by[j]);
       shape->set_positions(box->editor.positions());
@@ -257,6 +291,19 @@ struct Session::Impl {
       transforms.assign(key.handles.size(), identity_transform());
     }
     push_snapshot();
+  }
+  /// positions(budget) of the editor, as the answer to a move or a relax step. Under the lock.
+  Frame frame(double budget_ms) {
+    Editor& editor = box->editor;
+    const auto t0 = Clock::now();
+    Frame f;
+    const Eigen::MatrixXd& p = editor.positions(budget_ms);
+    f.positions = movable_floats(editor, p);
+    f.converged = editor.converged();
+    f.iterations = editor.report().method == "nonlinear" ? editor.report().nonlinear.iterations : 0;
+    f.ms = last_frame_ms = ms_since(t0);
+    shape->set_positions(editor.movable_vertices(), p);
+    return f;
   }
   EditorOptions editor_options() {
     EditorOptions o = options.editor;
@@ -317,7 +364,8 @@ void Session::start_load(std::string bytes, std::string name) {
   });
 }
 
-void Session::start_region(std::vector<int> support, std::vector<std::vector<int>> handles, int k) {
+void Session::start_region(std::vector<int> support, std::vector<std::vector<int>> handles, int k,
+                           EditMethod method) {
   std::lock_guard lock(impl_->mutex);
   Impl& m = *impl_;
   if (!(m.busy && m.job == "region")) m.require_ready(); // a region job: stopped and followed
@@ -334,36 +382,37 @@ void Session::start_region(std::vector<int> support, std::vector<std::vector<int
         throw InvalidArgument(fmt::format("handle vertex {} is out of range (the mesh has {} "
                                           "vertices)",
                                           v, n));
-  RegionKey key{std::move(support), std::move(handles), k};
-  // Only k changes: the same handles keep their transforms, solved again (no bake), so that a
-  // user compares k on the same drag.
-  const bool new_k = m.region && m.region->support == key.support &&
-                     m.region->handles == key.handles && m.region->k != key.k;
-  const bool bake = !new_k && !is_identity(m.transforms);
-  m.run("region", [this, key = std::move(key), bake, new_k, current = m.box,
+  RegionKey key{std::move(support), std::move(handles), k, method};
+  // Only k or the method changes: the same handles keep their transforms, solved again (no
+  // bake), so that a user compares them on the same drag. A new method alone needs no new
+  // set_region.
+  const bool same_paint =
+      m.region && m.region->support == key.support && m.region->handles == key.handles;
+  const bool resolve = same_paint && (m.region->k != key.k || m.region->method != key.method);
+  const bool new_region = !resolve || m.region->k != key.k;
+  const bool bake = !resolve && !is_identity(m.transforms);
+  m.run("region", [this, key = std::move(key), bake, resolve, new_region, current = m.box,
                    moved_by = m.transforms](std::stop_token token) {
-    impl_->region_job(key, bake, new_k, current, moved_by, token);
+    impl_->region_job(key, {bake, resolve, new_region}, current, moved_by, token);
   });
 }
 
-std::vector<float> Session::set_transform(int handle, const Transform& transform,
-                                          double* frame_ms) {
+Frame Session::set_transform(int handle, const Transform& transform) {
   std::lock_guard lock(impl_->mutex);
   Impl& m = *impl_;
   m.require_region();
   m.box->editor.set_transform(handle, transform); // validates
   m.transforms[static_cast<std::size_t>(handle)] = transform;
-  const auto t0 = Clock::now();
-  const Eigen::MatrixXd& p = m.box->editor.positions();
-  const std::vector<int>& movable = m.box->editor.movable_vertices();
-  std::vector<float> out(3 * movable.size());
-  for (std::size_t i = 0; i < movable.size(); ++i)
-    for (int c = 0; c < 3; ++c)
-      out[3 * i + static_cast<std::size_t>(c)] = static_cast<float>(p(movable[i], c));
-  m.last_frame_ms = ms_since(t0);
-  m.shape->set_positions(movable, p);
-  if (frame_ms) *frame_ms = m.last_frame_ms;
-  return out;
+  return m.frame(m.options.frame_budget_ms);
+}
+
+Frame Session::relax(double budget_ms) {
+  std::lock_guard lock(impl_->mutex);
+  Impl& m = *impl_;
+  m.require_region();
+  if (!(budget_ms > 0.0) || !(budget_ms <= 10000.0))
+    throw InvalidArgument("budget_ms: expected milliseconds above 0, at most 10000");
+  return m.frame(budget_ms);
 }
 
 void Session::commit() {
@@ -430,6 +479,7 @@ nlohmann::json Session::status() const {
     j["region"] = {{"support", m.region->support.size()},
                    {"handles", m.region->handles.size()},
                    {"k", m.region->k},
+                   {"method", to_string(m.region->method)},
                    {"free_base_vertices", r.free_base_vertices},
                    {"set_region_ms",
                     r.milliseconds.count("set_region") ? r.milliseconds.at("set_region") : 0.0},
@@ -442,6 +492,10 @@ nlohmann::json Session::status() const {
       transforms.push_back(row_major);
     }
     j["transforms"] = transforms;
+    if (m.region->method == EditMethod::Nonlinear)
+      j["nonlinear"] = {{"iterations", r.nonlinear.total_iterations},
+                        {"converged", m.box->editor.converged()},
+                        {"fallback", r.fallback}};
   }
   return j;
 }
@@ -451,7 +505,10 @@ nlohmann::json Session::region() const {
   const Impl& m = *impl_;
   m.require_ready();
   if (!m.region) return nullptr;
-  return {{"support", m.region->support}, {"handles", m.region->handles}, {"k", m.region->k}};
+  return {{"support", m.region->support},
+          {"handles", m.region->handles},
+          {"k", m.region->k},
+          {"method", to_string(m.region->method)}};
 }
 
 namespace {

@@ -109,6 +109,59 @@ async function kAfterMove(page, c, edit) {
   check(off < 1e-5, `k = 3 then 2 gives back the k = 2 shape without undo (off by ${off.toExponential(2)})`);
 }
 
+/// The page's positions against the server's: the largest difference.
+const pageVsServer = (page) => page.evaluate(async () => {
+  const server = new Float32Array(await (await fetch('api/mesh/positions')).arrayBuffer());
+  const held = window.remora.positionsHeld?.() ?? [];
+  let worst = held.length === server.length ? 0 : Infinity;
+  for (let i = 0; i < held.length && worst < Infinity; ++i) worst = Math.max(worst, Math.abs(held[i] - server[i]));
+  return worst;
+});
+
+/// The method switch after a move: nonlinear keeps the transforms and bends the support
+/// otherwise, converged; a drag under it is answered frame by frame and, once the pointer rests,
+/// relaxed until the server says converged, the page holding the server's positions; linear again
+/// gives back the linear shape.
+async function methodAfterMove(page, c, edit) {
+  const s0 = await c.json('status');
+  const linear = await c.floats('mesh/positions');
+  await page.selectOption('#method', 'nonlinear');
+  await ready(page);
+  const s1 = await c.json('status');
+  const moved = await c.floats('mesh/positions');
+  const inSupport = new Set(edit.region.support);
+  let change = 0, outside = 0;
+  for (let v = 0; v < linear.length / 3; ++v)
+    for (let k = 0; k < 3; ++k) {
+      const d = Math.abs(moved[3 * v + k] - linear[3 * v + k]);
+      if (inSupport.has(v)) change = Math.max(change, d); else if (d !== 0) outside += 1;
+    }
+  check(s1.region?.method === 'nonlinear' && JSON.stringify(s1.transforms) === JSON.stringify(s0.transforms) &&
+        s1.nonlinear?.converged === true && !s1.nonlinear?.fallback,
+        `the method nonlinear after a move keeps the transforms and converges (${JSON.stringify(s1.nonlinear)})`);
+  check(change > 1e-6 && outside === 0, `nonlinear bends the support otherwise (by ${change.toExponential(2)}), nothing outside it moves (${outside})`);
+  check(await pageVsServer(page) === 0, 'the page shows the nonlinear positions');
+  // A drag under nonlinear.
+  const frames0 = (await remora(page, 'marks')).drag.length;
+  await page.click('button[data-mode="translate"]');
+  const pivot = await remora(page, 'pivot');
+  const centre = await page.evaluate((q) => window.remora.projectPoint(...q), pivot);
+  // Downwards: the manipulator stays in view for the rules after this one.
+  await drag(page, centre.x, centre.y - 75, 0, 6);
+  await ready(page);
+  const s2 = await c.json('status');
+  const frames = (await remora(page, 'marks')).drag.length - frames0;
+  const off = await pageVsServer(page);
+  check(frames > 0 && s2.nonlinear?.converged === true && off < 1e-6,
+        `a nonlinear drag: ${frames} frames answered, then relaxed until converged (${JSON.stringify(s2.nonlinear)}), ` +
+        `the page holding the server's positions (off by ${off})`);
+  await page.selectOption('#method', 'linear');
+  await ready(page);
+  const s3 = await c.json('status');
+  check(s3.region?.method === 'linear' && !s3.nonlinear && await pageVsServer(page) === 0,
+        'the method linear again: the page shows its positions');
+}
+
 /// While a job runs (a stroke after a move: the shape is baked into a new base) the progress shows
 /// "phase — NN %" and undo, redo and export are disabled. The bake may start in a pause of the
 /// stroke and end before mouse-up, so the page is watched from the stroke's start.
@@ -259,6 +312,7 @@ export const bugChecks = {
     check(box && box.y >= 0 && box.y + box.height <= 800 && /set_region/.test(text),
           `at 1200x800 the stats, set_region line included, are in view (${box?.y.toFixed(0)}..${(box?.y + box?.height).toFixed(0)})`);
     await kAfterMove(page, c, edit);
+    await methodAfterMove(page, c, edit);
     await busyButtons(page, site);
     await scaleClamp(page, log);
     await exportName(page);

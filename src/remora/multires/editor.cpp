@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <deque>
+#include <limits>
 #include <optional>
 #include <utility>
 
@@ -18,6 +19,7 @@
 #include "remora/geometry/measures.h"
 #include "remora/multires/frame.h"
 #include "remora/multires/multigrid.h"
+#include "remora/multires/nonlinear_region.h"
 
 namespace remora {
 namespace {
@@ -76,6 +78,8 @@ struct Editor::Prepared::State {
   Eigen::MatrixXd current_positions;
   std::vector<double> face_normals; // update_normals()'s scratch
   bool dirty = true;
+  std::unique_ptr<NonlinearRegion> nonlinear; // method nonlinear (multires/nonlinear_region.h)
+  std::shared_ptr<const RemeshResult> coarse; // its preview level (kept by the editor)
 };
 
 using RegionState = Editor::Prepared::State;
@@ -96,6 +100,7 @@ struct Editor::Impl {
   std::optional<KHarmonicAssembler> assembler;     // B's systems
   BaseStatistics statistics;                       // of B: what a bake updates the report from
   std::unique_ptr<MultigridSolver> multigrid;
+  std::shared_ptr<const RemeshResult> coarse; // method nonlinear's preview level, for every region
   EditReport report;
   std::unique_ptr<RegionState> region;
   // The regions installed before the current one, the latest first: set_region() of one of them
@@ -114,7 +119,9 @@ struct Editor::Impl {
     if (!region) throw InvalidArgument("no region yet: call set_region() first");
     return *region;
   }
-  void update();
+  void update(double budget_ms);
+  void build_nonlinear(RegionState& r, EditReport& into);
+  void deform_base(RegionState& r, bool moved, double budget_ms);
 
   // The steps of set_region(), in order, on a new state (the current region stays until all
   // succeed).
@@ -513,6 +520,55 @@ void Editor::Impl::find_affected(RegionState& r) const {
   r.affected = plan_normals(topology, vertices);
 }
 
+// Method nonlinear: its deformers from B0, the labels and the handles' scalar weights (the basis
+// functions' "1" columns); for a large support the coarse base of its preview, made once and
+// kept while the regions' sizes call for about the same coarse edge length.
+void Editor::Impl::build_nonlinear(RegionState& r, EditReport& into) {
+  const auto t0 = Clock::now();
+  Eigen::MatrixXd weights = Eigen::MatrixXd::Zero(r.rest.rows(), r.handles);
+  for (std::size_t row = 0; row < r.free_vertices.size(); ++row)
+    for (int j = 0; j < r.handles; ++j)
+      weights(r.free_vertices[row], j) =
+          static_cast<double>(r.basis(static_cast<Eigen::Index>(row), 3 + 4 * j + 3));
+  for (int j = 0; j < r.handles; ++j)
+    for (const int v : r.handle_base[static_cast<std::size_t>(j)]) weights(v, j) = 1.0;
+  NonlinearOptions o = options.nonlinear;
+  o.threads = options.threads;
+  const std::size_t n_free = r.free_vertices.size();
+  const bool preview =
+      o.preview_vertices > 0 && n_free > 2 * static_cast<std::size_t>(o.preview_vertices);
+  if (preview) {
+    const double wanted = coarse_length(mean_edge_length(base), n_free, o);
+    r.coarse = coarse;
+    if (!r.coarse || std::abs(mean_edge_length(r.coarse->mesh) / wanted - 1.0) > 0.5) {
+      const auto t1 = Clock::now();
+      r.coarse = std::make_shared<const RemeshResult>(make_coarse_base(base, n_free, o));
+      into.milliseconds["nonlinear coarse base"] = ms_since(t1);
+    }
+  }
+  r.nonlinear = std::make_unique<NonlinearRegion>(base, preview ? r.coarse.get() : nullptr, r.rest,
+                                                  r.base_label, weights, o);
+  into.milliseconds["nonlinear setup"] = ms_since(t0);
+}
+
+// Method nonlinear, in a frame: r.current_base holds the blend (the linear result); the region's
+// nonlinear state replaces its free rows, or leaves the blend with a message.
+void Editor::Impl::deform_base(RegionState& r, bool moved, double budget_ms) {
+  if (!r.nonlinear) { // after set_method()
+    build_nonlinear(r, report);
+    if (r.coarse) coarse = r.coarse;
+  }
+  const auto t0 = Clock::now();
+  RowPoints positions = r.frame.leftCols<3>();
+  r.nonlinear->frame(r.transforms, moved, budget_ms, positions);
+  r.frame.leftCols<3>() = positions;
+  report.method = "nonlinear";
+  report.nonlinear = r.nonlinear->stats();
+  report.nonlinear_level = r.nonlinear->level();
+  report.fallback = r.nonlinear->fallback();
+  report.milliseconds["frame nonlinear"] = ms_since(t0);
+}
+
 Editor::Prepared::Prepared() = default;
 Editor::Prepared::Prepared(Prepared&&) noexcept = default;
 Editor::Prepared& Editor::Prepared::operator=(Prepared&&) noexcept = default;
@@ -558,6 +614,7 @@ Editor::Prepared Editor::prepare_region(const std::vector<int>& support,
   m.find_affected(r);
   m.encode_details(r, r.report, stop);
   check();
+  if (m.options.method == EditMethod::Nonlinear) m.build_nonlinear(r, r.report);
   r.transforms.assign(static_cast<std::size_t>(r.handles), identity_transform());
   r.frame = frame_rows(r.rest, r.rest_normals);
   r.rest_normals.resize(0, 0); // in the frame now
@@ -582,6 +639,7 @@ void Editor::install_region(Prepared&& prepared) {
     impl_->recent.push_front(std::move(impl_->region));
     if (impl_->recent.size() > Impl::kRecentRegions) impl_->recent.pop_back();
   }
+  if (prepared.state_->coarse) impl_->coarse = prepared.state_->coarse;
   impl_->region = std::move(prepared.state_);
 }
 
@@ -612,6 +670,13 @@ void Editor::set_system(const KHarmonicOptions& system) {
   o.system = system;
   check_options(o);
   impl_->options.system = system;
+}
+
+void Editor::set_method(EditMethod method) {
+  Impl& m = *impl_;
+  m.options.method = method;
+  if (!m.region) return;
+  m.region->dirty = true;
 }
 
 Eigen::Vector3d Editor::handle_center(int handle) const {
@@ -645,9 +710,11 @@ const Transform& Editor::transform(int handle) const {
   return r.transforms[static_cast<std::size_t>(handle)];
 }
 
-void Editor::Impl::update() {
+void Editor::Impl::update(double budget_ms) {
   RegionState& r = state();
-  if (!r.dirty) return;
+  const bool iterating =
+      options.method == EditMethod::Nonlinear && r.nonlinear && !r.nonlinear->finished();
+  if (!r.dirty && !iterating) return;
   const auto t0 = Clock::now();
   // Blend: X_free = Φ_0 + Σ_j Φ_j [M_jᵀ; t_jᵀ].
   Eigen::MatrixXd coefficients(3 + 4 * r.handles, 3);
@@ -662,8 +729,10 @@ void Editor::Impl::update() {
       r.frame.row(v).head<3>() =
           (t.leftCols<3>() * base_rest.row(v).transpose() + t.col(3)).transpose();
   }
-  const auto t_normals = Clock::now();
   report.milliseconds["frame blend"] = ms_since(t0);
+  report.method = to_string(options.method);
+  if (options.method == EditMethod::Nonlinear) deform_base(r, r.dirty, budget_ms);
+  const auto t_normals = Clock::now();
   // Normals where they can change.
   update_normals(topology, r.affected, r.frame, r.face_normals, threads);
   const auto t_decode = Clock::now();
@@ -675,8 +744,18 @@ void Editor::Impl::update() {
 }
 
 const Eigen::MatrixXd& Editor::positions() {
-  impl_->update();
+  return positions(std::numeric_limits<double>::infinity());
+}
+
+const Eigen::MatrixXd& Editor::positions(double budget_ms) {
+  impl_->update(budget_ms);
   return impl_->region->current_positions;
+}
+
+bool Editor::converged() const {
+  const RegionState* r = impl_->region.get();
+  if (!r || impl_->options.method == EditMethod::Linear) return true;
+  return !r->dirty && r->nonlinear && r->nonlinear->finished();
 }
 
 Mesh Editor::result() {
@@ -695,7 +774,7 @@ const Mesh& Editor::base() const {
 }
 
 Eigen::MatrixXd Editor::base_positions() {
-  impl_->update();
+  impl_->update(std::numeric_limits<double>::infinity());
   return impl_->region->frame.leftCols<3>();
 }
 
@@ -756,6 +835,14 @@ nlohmann::json to_json(const EditReport& r) {
                 {"extrapolated", r.phong.extrapolated},
                 {"fallbacks", r.phong.fallbacks},
                 {"max_abs_offset", r.phong.max_abs_offset}};
+  j["method"] = r.method;
+  if (r.method == "nonlinear") {
+    const NonlinearStats& n = r.nonlinear;
+    j["nonlinear"] = {{"iterations", n.iterations},   {"total_iterations", n.total_iterations},
+                      {"accelerated", n.accelerated}, {"converged", n.converged},
+                      {"last_move", n.last_move},     {"energy", n.energy},
+                      {"fallback", r.fallback}};
+  }
   j["milliseconds"] = r.milliseconds;
   return j;
 }

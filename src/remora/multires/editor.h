@@ -43,6 +43,7 @@
 #include "remora/mesh/mesh.h"
 #include "remora/multires/base_figures.h"
 #include "remora/multires/base_surface.h"
+#include "remora/multires/nonlinear.h"
 #include "remora/multires/phong.h"
 #include "remora/remesh/remesh.h"
 
@@ -82,6 +83,8 @@ struct EditorOptions {
   /// direct solver for a symmetric system, "lu" for the Mixed one.
   SolverOptions solver;
   DetailMode details = DetailMode::Normal;
+  EditMethod method = EditMethod::Linear;
+  NonlinearOptions nonlinear; ///< method Nonlinear: the energy and its iterations
   PhongOptions phong;
   int threads = 0; ///< 0 = all hardware threads
   /// Called at the start of every phase: (phase name, step, number of steps).
@@ -115,6 +118,14 @@ struct EditReport {
   SolverStats solver_stats;
   int solves = 0; ///< right-hand sides solved (3 + 4h)
   PhongStats phong;
+  /// The base's deformation in the last frame: "linear" or "nonlinear".
+  std::string method = "linear";
+  NonlinearStats nonlinear; ///< method nonlinear: the last frame's iterations
+  /// Method nonlinear: "coarse" when the last frame showed the preview of a large support,
+  /// "fine" otherwise (multires/nonlinear_region.h).
+  std::string nonlinear_level;
+  /// Method nonlinear: why the last frame shows the linear result instead (empty otherwise).
+  std::string fallback;
   /// Wall time in milliseconds: "base", "remesh", "set_region" (and its parts "assemble",
   /// "factor", "solve", "encode"), "frame" (the last positions() that had work to do).
   std::map<std::string, double> milliseconds;
@@ -213,6 +224,11 @@ public:
   /// Changes k and the area weights for the next set_region(). Throws InvalidArgument for a k
   /// other than 1, 2, 3, or weights the configured solver cannot take.
   void set_system(const KHarmonicOptions& system);
+  /// Switches the base's deformation, for the current region and the next ones. Cheap: the next
+  /// positions() call builds what nonlinear needs for the current region if set_region did not
+  /// (a factorization, as in set_region; a failure leaves the linear result with a message in
+  /// the report).
+  void set_method(EditMethod method);
   /// The centroid of handle j's vertices on O (the default center of rotations and scalings).
   Eigen::Vector3d handle_center(int handle) const;
 
@@ -224,8 +240,16 @@ public:
   const Transform& transform(int handle) const;
 
   /// Step 7: O's vertex positions under the current transforms (n_vertices × 3). Blends the basis
-  /// functions and decodes the details when a transform changed since the last call.
+  /// functions and decodes the details when a transform changed since the last call. Method
+  /// nonlinear: iterates until converged (or its max_iterations).
   const Eigen::MatrixXd& positions();
+  /// Method nonlinear while a handle is dragged: at most `budget_ms` of iterations (at least
+  /// one), continuing from the last call, then the decode; call again to go on towards
+  /// convergence. The same as positions() for method linear.
+  const Eigen::MatrixXd& positions(double budget_ms);
+  /// Whether positions() are final: true for method linear, and for nonlinear once the
+  /// iteration has converged, reached its max_iterations or fallen back to the linear result.
+  bool converged() const;
   /// O with positions(): same connectivity, bit-identical points outside the support.
   Mesh result();
 
