@@ -4,6 +4,7 @@
 // Every call into the editor runs without the GIL and under the editor's own mutex (so that two
 // Python threads cannot enter one editor at once). The mutex is only ever waited for without the
 // GIL, so the two cannot deadlock.
+#include <cmath>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -25,10 +26,10 @@ namespace {
 const OptionSetters<SolverOptions>& solver_setters() {
   using O = SolverOptions;
   static const OptionSetters<O> setters = {
-      {"ordering", [](O& o, const py::handle& v) { o.ordering = option_string(v); }},
-      {"preconditioner", [](O& o, const py::handle& v) { o.preconditioner = option_string(v); }},
-      {"tolerance", [](O& o, const py::handle& v) { o.tolerance = option_real(v); }},
-      {"max_iterations", [](O& o, const py::handle& v) { o.max_iterations = option_int(v); }},
+      {"ordering", string_field(&O::ordering)},
+      {"preconditioner", string_field(&O::preconditioner)},
+      {"tolerance", real_field(&O::tolerance)},
+      {"max_iterations", int_field(&O::max_iterations)},
   };
   return setters;
 }
@@ -55,14 +56,14 @@ const OptionSetters<EditorOptions>& editor_setters() {
        }},
       {"details",
        [](O& o, const py::handle& v) { o.details = parse_detail_mode(option_string(v)); }},
-      {"remesh", [](O& o, const py::handle& v) { o.remesh = option_bool(v); }},
+      {"remesh", bool_field(&O::remesh)},
       {"base_smoothing", [](O& o, const py::handle& v) { o.base.smoothing = option_real(v); }},
       {"base_feature_cap", [](O& o, const py::handle& v) { o.base.feature_cap = option_real(v); }},
       {"remesh_options",
        [](O& o, const py::handle& v) {
          apply_nested("remesh_options", v, remesh_setters(), o.remesh_options);
        }},
-      {"threads", [](O& o, const py::handle& v) { o.threads = option_int(v); }},
+      {"threads", int_field(&O::threads)},
       {"progress", [](O& o, const py::handle& v) { o.progress = progress_arg(v); }},
   };
   return setters;

@@ -47,12 +47,12 @@ void write(const std::string& path, const py::handle& vertices, const py::handle
 }
 
 const OptionSetters<RepairOptions>& repair_setters() {
-  static const OptionSetters<RepairOptions> setters = {
-      {"weld", [](RepairOptions& o, const py::handle& v) { o.weld = option_bool(v); }},
-      {"weld_tolerance",
-       [](RepairOptions& o, const py::handle& v) { o.weld_tolerance = option_real(v); }},
-      {"orient", [](RepairOptions& o, const py::handle& v) { o.orient = option_bool(v); }},
-      {"outward", [](RepairOptions& o, const py::handle& v) { o.outward = option_bool(v); }},
+  using O = RepairOptions;
+  static const OptionSetters<O> setters = {
+      {"weld", bool_field(&O::weld)},
+      {"weld_tolerance", real_field(&O::weld_tolerance)},
+      {"orient", bool_field(&O::orient)},
+      {"outward", bool_field(&O::outward)},
   };
   return setters;
 }

@@ -12,19 +12,6 @@ namespace remora::python {
 
 namespace {
 
-template <class T>
-auto real_field(T RemeshOptions::*member) {
-  return [member](RemeshOptions& o, const py::handle& v) { o.*member = option_real(v); };
-}
-template <class T>
-auto int_field(T RemeshOptions::*member) {
-  return [member](RemeshOptions& o, const py::handle& v) { o.*member = option_int(v); };
-}
-template <class T>
-auto bool_field(T RemeshOptions::*member) {
-  return [member](RemeshOptions& o, const py::handle& v) { o.*member = option_bool(v); };
-}
-
 Equalization parse_equalization(const std::string& name) {
   if (name == "newton") return Equalization::Newton;
   if (name == "gravity") return Equalization::Gravity;
@@ -60,12 +47,9 @@ py::tuple remesh_arrays(const py::handle& vertices, const py::handle& faces,
 const OptionSetters<LowPassOptions>& low_pass_setters() {
   using O = LowPassOptions;
   static const OptionSetters<O> setters = {
-      {"smoothing", [](O& o, const py::handle& v) { o.smoothing = option_real(v); }},
-      {"feature_cap", [](O& o, const py::handle& v) { o.feature_cap = option_real(v); }},
-      {"cap_slope", [](O& o, const py::handle& v) { o.cap_slope = option_real(v); }},
-      {"steps", [](O& o, const py::handle& v) { o.steps = option_int(v); }},
-      {"tolerance", [](O& o, const py::handle& v) { o.tolerance = option_real(v); }},
-      {"threads", [](O& o, const py::handle& v) { o.threads = option_int(v); }},
+      {"smoothing", real_field(&O::smoothing)}, {"feature_cap", real_field(&O::feature_cap)},
+      {"cap_slope", real_field(&O::cap_slope)}, {"steps", int_field(&O::steps)},
+      {"tolerance", real_field(&O::tolerance)}, {"threads", int_field(&O::threads)},
   };
   return setters;
 }

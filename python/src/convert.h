@@ -86,6 +86,24 @@ int option_int(const py::handle& value);
 bool option_bool(const py::handle& value);
 std::string option_string(const py::handle& value);
 
+/// Setters of one field of an options struct: {"cycles", int_field(&RemeshOptions::cycles)}.
+template <class O, class T>
+auto real_field(T O::*member) {
+  return [member](O& o, const py::handle& v) { o.*member = option_real(v); };
+}
+template <class O, class T>
+auto int_field(T O::*member) {
+  return [member](O& o, const py::handle& v) { o.*member = option_int(v); };
+}
+template <class O, class T>
+auto bool_field(T O::*member) {
+  return [member](O& o, const py::handle& v) { o.*member = option_bool(v); };
+}
+template <class O, class T>
+auto string_field(T O::*member) {
+  return [member](O& o, const py::handle& v) { o.*member = option_string(v); };
+}
+
 /// The message for an option a setter refused (what: option: problem).
 [[noreturn]] void bad_option(const char* what, const std::string& name, const std::string& problem);
 [[noreturn]] void unknown_option(const char* what, const std::string& name,

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import remora
-from conftest import grid, octahedron
+from conftest import grid
 
 
 @pytest.fixture(scope="module")

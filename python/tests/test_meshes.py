@@ -31,6 +31,18 @@ def test_write_and_read_round_trip_exactly(bunny, tmp_path, suffix, binary):
     assert np.array_equal(back.F, bunny.F[:, [1, 2, 0]])
 
 
+def test_any_layout_and_array_like_is_accepted(bunny):
+    # Fortran order, strided views, lists and tuples: converted once, same figures.
+    V, F = bunny.V, bunny.F
+    expected = remora.quality(V, F)
+    wide = np.zeros((len(V), 6))
+    wide[:, ::2] = V
+    assert remora.quality(np.asfortranarray(V), np.asfortranarray(F)) == expected
+    assert remora.quality(wide[:, ::2], F.astype(np.int32)) == expected
+    small_V, small_F = octahedron()
+    assert remora.quality(small_V.tolist(), tuple(map(tuple, small_F)))["faces"] == 8
+
+
 def test_repair_leaves_a_clean_mesh_as_it_is(bunny):
     # arrays -> soup -> repaired mesh -> arrays keeps every vertex and corner in order.
     r = remora.remesh(bunny.V, bunny.F, cycles=1, max_cycles=1, equalize_iterations=0,
