@@ -120,8 +120,9 @@ class Editor:
         """The mesh's vertex positions under the current transforms, (n, 3) float64.
 
         A new array, or ``out`` (a writeable C-contiguous (n, 3) float64 array) filled and
-        returned, which saves the allocation in an interactive loop. Before :meth:`set_region`,
-        the rest positions.
+        returned, which saves the allocation in an interactive loop. Only the first call after a
+        :meth:`set_transform` computes (blend and decode, no solve). Raises ValueError before
+        :meth:`set_region`.
         """
         return self._editor.positions(out)
 

@@ -43,6 +43,8 @@ void apply_nested(const char* what, const py::handle& value, const OptionSetters
   apply_options(what, py::reinterpret_borrow<py::dict>(value), setters, options);
 }
 
+/// Editor(V, F, **options): one entry per EditorOptions field a Python caller may set (a new
+/// field is one more line here and in the docstring of python/remora/_editor.py).
 const OptionSetters<EditorOptions>& editor_setters() {
   using O = EditorOptions;
   static const OptionSetters<O> setters = {

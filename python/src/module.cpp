@@ -16,7 +16,11 @@ namespace py = pybind11;
 PYBIND11_MODULE(_remora, m) {
   m.doc() = "Remora's compiled core; use the package `remora`, which documents every function.";
   m.attr("__version__") = REMORA_VERSION;
-  m.attr("WITH_GPL_SOLVERS") = remora::default_solver_name() == "cholmod";
+#ifdef REMORA_WITH_GPL_SOLVERS
+  m.attr("WITH_GPL_SOLVERS") = true;
+#else
+  m.attr("WITH_GPL_SOLVERS") = false;
+#endif
   m.def("solver_names", &remora::solver_names);
   m.def("default_solver_name", &remora::default_solver_name);
 

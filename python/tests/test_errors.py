@@ -99,6 +99,16 @@ def test_bad_regions(editor):
         editor.set_region(np.arange(20), [[60]])  # a handle outside the support
 
 
+def test_no_region_yet(flat):
+    V, F = flat
+    fresh = remora.Editor(V, F, base_smoothing=0.0)
+    assert fresh.handle_count == 0 and len(fresh.movable_vertices()) == 0
+    with pytest.raises(ValueError, match=r"no region yet: call set_region\(\) first"):
+        fresh.positions()
+    with pytest.raises(ValueError, match=r"no region yet"):
+        fresh.set_transform(0, np.eye(3, 4))
+
+
 def test_bad_transforms(editor):
     V = np.asarray(editor.base()[0])
     editor.set_region(np.arange(editor.n_vertices), [[0]])
