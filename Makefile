@@ -9,6 +9,9 @@ CMAKE_FLAGS ?=
 DEMO_MESH  ?= data/bunny.ply
 BENCH_ARGS ?=
 PORT       ?= 8080
+# Debian's interpreter, which has Debian's numpy, scipy and pybind11, even when another python3
+# (pyenv, conda) comes first on PATH; the Python module is built for it and tested with it.
+PYTHON     ?= $(firstword $(wildcard /usr/bin/python3) python3)
 
 PHONY_EXTRA = deps-web serve
 .PHONY: all deps deps-bench $(PHONY_EXTRA) build demo test test-release test-asan bench format format-check clean
@@ -28,7 +31,7 @@ deps-web:
 # the CGAL-free default.
 build: deps
 	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release -DREMORA_WERROR=ON -DREMORA_WITH_CGAL=OFF \
-	  $(CMAKE_FLAGS)
+	  -DPython3_EXECUTABLE=$(PYTHON) $(CMAKE_FLAGS)
 	cmake --build $(BUILD) -j$(JOBS)
 
 # The quality report of the bundled scan, its area-equalizing remesh (paper §4), one edit from
@@ -50,11 +53,14 @@ serve: build
 # from real results: `remora serve` edits, the page draws in headless chromium
 # (scripts/render_pictures.mjs; chromium is installed when missing). The shared meshes come from
 # ../shared/data (or REMORA_DATA); a missing one skips its picture. Not part of `make test`, whose
-# WebEditor.Pictures runs the same script at a low resolution into the build folder.
+# WebEditor.Pictures runs the same script at a low resolution into the build folder. Then
+# python_tutorial.png, which docs/python.md's tutorial draws with matplotlib
+# (scripts/python_tutorial.py; Python.test_docs runs it in `make test`).
 .PHONY: pictures
 pictures: build
 	@scripts/bootstrap.sh --web
 	node scripts/render_pictures.mjs --out docs/images --cli $(BUILD)/bin/remora --web-root $(BUILD)/web
+	PYTHONPATH=$(BUILD)/python $(PYTHON) scripts/python_tutorial.py --out docs/images/python_tutorial.png
 
 # The browser editor's latency (web/tests/bench.mjs): `remora serve` on MESH, the real page driven
 # with the mouse in headless chromium; the last line printed is one JSON object of medians in
@@ -110,4 +116,4 @@ format-check:
 	@clang-format --dry-run --Werror $(FORMAT_FILES) && echo "format-check: clean"
 
 clean:
-	rm -rf $(BUILD) $(ASAN_BUILD)
+	rm -rf $(BUILD) $(ASAN_BUILD) build-pip
