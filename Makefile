@@ -11,6 +11,9 @@ CMAKE_FLAGS ?=
 DEMO_MESH  ?= data/bunny.ply
 BENCH_ARGS ?=
 PORT       ?= 8080
+# Debian's interpreter, which has Debian's numpy, scipy and pybind11, even when another python3
+# (pyenv, conda) comes first on PATH; the Python module is built for it and tested with it.
+PYTHON     ?= $(firstword $(wildcard /usr/bin/python3) python3)
 
 PHONY_EXTRA = deps-web serve
 .PHONY: all deps deps-bench $(PHONY_EXTRA) build demo test test-release test-asan test-tsan fuzz soak \
@@ -32,7 +35,7 @@ deps-web:
 # `remora bench` commands are part of the CLI and always built).
 build: deps
 	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release -DREMORA_WERROR=ON -DREMORA_WITH_CGAL=OFF \
-	  -DREMORA_BUILD_BENCH=OFF $(CMAKE_FLAGS)
+	  -DREMORA_BUILD_BENCH=OFF -DPython3_EXECUTABLE=$(PYTHON) $(CMAKE_FLAGS)
 	cmake --build $(BUILD) -j$(JOBS)
 
 # The quality report of the bundled scan, its area-equalizing remesh (paper §4), one edit from
@@ -54,11 +57,14 @@ serve: build
 # from real results: `remora serve` edits, the page draws in headless chromium
 # (scripts/render_pictures.mjs; chromium is installed when missing). The shared meshes come from
 # ../shared/data (or REMORA_DATA); a missing one skips its picture. Not part of `make test`, whose
-# WebEditor.Pictures runs the same script at a low resolution into the build folder.
+# WebEditor.Pictures runs the same script at a low resolution into the build folder. Then
+# python_tutorial.png, which docs/python.md's tutorial draws with matplotlib
+# (scripts/python_tutorial.py; Python.test_docs runs it in `make test`).
 .PHONY: pictures
 pictures: build
 	@scripts/bootstrap.sh --web
 	node scripts/render_pictures.mjs --out docs/images --cli $(BUILD)/bin/remora --web-root $(BUILD)/web
+	PYTHONPATH=$(BUILD)/python $(PYTHON) scripts/python_tutorial.py --out docs/images/python_tutorial.png
 
 # The browser editor's latency (web/tests/bench.mjs): `remora serve` on MESH, the real page driven
 # with the mouse in headless chromium; the last line printed is one JSON object of medians in
@@ -168,4 +174,4 @@ format-check:
 	@clang-format --dry-run --Werror $(FORMAT_FILES) && echo "format-check: clean"
 
 clean:
-	rm -rf $(BUILD) $(ASAN_BUILD) $(TSAN_BUILD) $(FUZZ_BUILD)
+	rm -rf $(BUILD) $(ASAN_BUILD) $(TSAN_BUILD) $(FUZZ_BUILD) build-pip

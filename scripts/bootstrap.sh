@@ -8,7 +8,9 @@
 #   scripts/bootstrap.sh --web     those plus Debian's chromium, which the browser editor's
 #                                  end-to-end test drives (make test)
 # Node.js and npm (for three.js and playwright-core, scripts/build_web.sh) are installed from
-# Debian when the machine has no `npm` command.
+# Debian when the machine has no `npm` command. The Python module (python/, docs/python.md) is
+# built against Debian's /usr/bin/python3 with its pybind11, numpy and scipy; pytest, matplotlib,
+# setuptools, wheel, pip and venv are for its tests, tutorial and `pip install .`.
 set -euo pipefail
 
 bench=0
@@ -31,6 +33,8 @@ packages=(
   libsuitesparse-dev libmetis-dev libopenblas-dev
   libcli11-dev nlohmann-json3-dev libspdlog-dev libfmt-dev libcpp-httplib-dev
   libgtest-dev libgmock-dev libbenchmark-dev
+  pybind11-dev python3-dev python3-numpy python3-scipy python3-pytest python3-matplotlib
+  python3-setuptools python3-wheel python3-pip python3-venv
 )
 if [ "$bench" -eq 1 ]; then
   packages+=(libcgal-dev)

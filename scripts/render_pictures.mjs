@@ -9,7 +9,9 @@
 //   node scripts/render_pictures.mjs [--out docs/images] [--width 800] [--height 500] [--scale S]
 //        [--only NAME[,NAME...]] [--cli build/bin/remora] [--web-root build/web]
 //
-// Pictures: bunny_ear, acrossriver_lift, base_area, needles_base. The shared meshes are read from
+// Pictures: bunny_ear, acrossriver_lift, base_area, needles_base, cylinder_twist and bunny_ear_twist
+// (the methods linear and nonlinear side by side; the bumpy cylinder is written by this script into
+// the system's temporary folder). The shared meshes are read from
 // ../shared/data beside the repository (REMORA_DATA overrides); a missing one skips its picture
 // with a message. Each PNG is written to a temporary name and renamed, so none is ever partial.
 // Exit code 0: done (maybe with skips), 1: failed, 2: usage error, 77: chromium or playwright-core
@@ -17,6 +19,7 @@
 import { spawn } from 'node:child_process';
 import { existsSync, mkdirSync, readFileSync, renameSync, rmSync, writeFileSync } from 'node:fs';
 import { createRequire } from 'node:module';
+import { tmpdir } from 'node:os';
 import { basename, dirname, join, resolve } from 'node:path';
 import { fileURLToPath } from 'node:url';
 import { deflateSync } from 'node:zlib';
@@ -24,7 +27,7 @@ import { deflateSync } from 'node:zlib';
 const root = resolve(dirname(fileURLToPath(import.meta.url)), '..');
 const usage = `usage: node scripts/render_pictures.mjs [--out DIR] [--width W] [--height H] [--scale S]
        [--only NAME[,NAME...]] [--cli PATH] [--web-root DIR]
-pictures: bunny_ear, acrossriver_lift, base_area, needles_base`;
+pictures: bunny_ear, acrossriver_lift, base_area, needles_base, cylinder_twist, bunny_ear_twist`;
 
 // ---- options ------------------------------------------------------------------------------------
 function parseOptions(argv) {
@@ -65,12 +68,34 @@ const BUNNY = { path: join(root, 'data/bunny.ply'), bundled: true };
 const ACROSS_RIVER = { path: join(dataDir, 'heightfield/AcrossRiver.stl') };
 const FEATURETYPE = { path: join(dataDir, 'cad/featuretype.STL') };
 
+/// An open cylinder of radius 1 and height 4 about z with bumps of amplitude 0.02 (12 around,
+/// wavelength 0.5 along z): make_cylinder(70, 96, 1, 4) of src/remora/mesh/primitives.h and the
+/// bumps of tests/test_nonlinear.cpp, as an OBJ file.
+function writeBumpyCylinder(path) {
+  const rings = 70, segments = 96, lines = [];
+  for (let k = 0; k <= rings; ++k)
+    for (let s = 0; s < segments; ++s) {
+      const phi = 2 * Math.PI * (s + (k % 2 ? 0.5 : 0)) / segments, z = 4 * k / rings;
+      const r = 1 + 0.02 * Math.sin(12 * phi) * Math.sin(2 * Math.PI * z / 0.5);
+      lines.push(`v ${r * Math.cos(phi)} ${r * Math.sin(phi)} ${z}`);
+    }
+  const id = (k, s) => k * segments + (s % segments) + 1;
+  for (let k = 0; k < rings; ++k)
+    for (let s = 0; s < segments; ++s)
+      if (k % 2 === 0) lines.push(`f ${id(k, s)} ${id(k, s + 1)} ${id(k + 1, s)}`, `f ${id(k, s + 1)} ${id(k + 1, s + 1)} ${id(k + 1, s)}`);
+      else lines.push(`f ${id(k, s)} ${id(k + 1, s + 1)} ${id(k + 1, s)}`, `f ${id(k, s)} ${id(k, s + 1)} ${id(k + 1, s + 1)}`);
+  writeFileSync(path, lines.join('\n') + '\n');
+}
+const CYLINDER = { path: join(tmpdir(), `remora_bumpy_cylinder_${process.pid}.obj`), generate: writeBumpyCylinder };
+
 const sphere = (c, r) => (p) => (p[0] - c[0]) ** 2 + (p[1] - c[1]) ** 2 + (p[2] - c[2]) ** 2 <= r * r;
 const disc = (c, r) => (p) => (p[0] - c[0]) ** 2 + (p[1] - c[1]) ** 2 <= r * r; // in x, y (plan view)
+const above = (z) => (p) => p[2] > z;
 
 // A picture: the mesh, an optional edit (a support and a handle as vertex predicates, the handle's
 // translation and rotation about its centroid, as `remora edit` does), and two panels, each a view
-// of the page (its URL options) before or after the edit, side by side (row) or stacked (column).
+// of the page (its URL options) before or after the edit (after it with the panel's method, linear
+// unless it says), side by side (row) or stacked (column).
 const PICTURES = [
   {
     name: 'base_area', mesh: BUNNY, layout: 'row',
@@ -92,6 +117,27 @@ const PICTURES = [
     panels: [
       { label: 'bunny.ply', stage: 'before', camera: [0.1, 0.2, 0.34, -0.02, 0.115, 0.0] },
       { label: 'after the edit', stage: 'after', camera: [0.1, 0.2, 0.34, -0.02, 0.115, 0.0] },
+    ],
+  },
+  {
+    name: 'cylinder_twist', mesh: CYLINDER, layout: 'row',
+    edit: { support: above(0.01), handle: above(3.99), rotate: { axis: [0, 0, 1], degrees: 90 } },
+    caption: 'an open cylinder with bumps, everything but the bottom circle free, the top circle turned 90°',
+    panels: [
+      { label: 'linear: the middle shrinks to 0.80 of the radius', stage: 'after', method: 'linear',
+        camera: [6.5, -6.5, 4.0, 0, 0, 1.9, 0, 0, 1] },
+      { label: 'nonlinear: 0.94', stage: 'after', method: 'nonlinear',
+        camera: [6.5, -6.5, 4.0, 0, 0, 1.9, 0, 0, 1] },
+    ],
+  },
+  {
+    name: 'bunny_ear_twist', mesh: BUNNY, layout: 'row',
+    edit: { support: sphere([-0.03, 0.15, 0], 0.05), handle: sphere([-0.03, 0.17, 0], 0.015),
+            rotate: { axis: [0, 1, 0], degrees: 90 } },
+    caption: 'the ear\'s tip turned 90° about y',
+    panels: [
+      { label: 'linear', stage: 'after', method: 'linear', camera: [0.1, 0.2, 0.34, -0.02, 0.115, 0.0] },
+      { label: 'nonlinear', stage: 'after', method: 'nonlinear', camera: [0.1, 0.2, 0.34, -0.02, 0.115, 0.0] },
     ],
   },
   {
@@ -321,6 +367,7 @@ async function main() {
   const todo = [];
   for (const picture of PICTURES) {
     if (o.only && !o.only.includes(picture.name)) continue;
+    if (picture.mesh.generate && !existsSync(picture.mesh.path)) picture.mesh.generate(picture.mesh.path);
     if (!existsSync(picture.mesh.path)) {
       console.log(`skip ${picture.name}.png: ${picture.mesh.path} is missing (point REMORA_DATA at the shared data)`);
       continue;
@@ -406,13 +453,22 @@ async function main() {
         if (handle.length < 3 || support.length <= handle.length)
           throw new Error(`${picture.name}: the region selects ${support.length} support and ${handle.length} handle vertices`);
         loaded.pristine = false;
-        await post('region', { support, handles: [handle], k: 2 });
+        await post('region', { support, handles: [handle], k: 2, method: 'linear' });
         await settle();
         await shoot('before');
         await post('transform', { handle: 0, matrix: handleMatrix(picture.edit, positions, handle) });
         await post('commit');
         await settle();
-        await shoot('after');
+        // The same region and move under each panel's method (a new method keeps the move).
+        for (const method of [...new Set(picture.panels.map((p) => p.method ?? 'linear'))]) {
+          if (method !== 'linear') {
+            await post('region', { support, handles: [handle], k: 2, method });
+            await settle();
+          }
+          for (const [i, panel] of picture.panels.entries())
+            if (panel.stage === 'after' && (panel.method ?? 'linear') === method)
+              shots[i] = await view({ camera: panel.camera.join(','), ...(panel.show ?? {}) });
+        }
       }
       await page.close();
 
@@ -425,6 +481,7 @@ async function main() {
   } finally {
     await browser.close();
     stopServer();
+    rmSync(CYLINDER.path, { force: true });
   }
   return 0;
 }

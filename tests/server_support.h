@@ -18,8 +18,8 @@
 namespace remora::server::testing_server {
 
 /// A bumpy sphere as OFF text, made in memory (tests run in parallel: no shared temporary file).
-inline std::string sphere_off() {
-  Mesh m = make_icosphere(3, 1.0);
+inline std::string sphere_off(int subdivisions = 3) {
+  Mesh m = make_icosphere(subdivisions, 1.0);
   std::ostringstream s;
   s.precision(17);
   s << "OFF\n" << m.n_vertices() << " " << m.n_faces() << " 0\n";

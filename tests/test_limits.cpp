@@ -2,6 +2,7 @@
 // the reader first learns of them, before it allocates for them), the default that follows from
 // the machine's memory, the handles and region lists the server takes, and how deep EDIT.json's
 // unions nest. Each is refused with a message that names it.
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -158,6 +159,42 @@ TEST(Limits, ARegionOverItsMemoryIsRefusedBeforeTheFactorization) {
         << e.what();
   }
   EXPECT_EQ(editor.movable_vertices().size(), cap_movable); // the cap's region stays
+}
+
+// The regions an editor keeps for an undo give way to a new region that has no room beside them:
+// with room for one region, setting the first again after a second solves it again (the same
+// doubles); without a limit it is reused as it was.
+TEST(Limits, RegionsKeptForAnUndoGiveWayToANewOne) {
+  const Mesh sphere = make_icosphere(3, 1.0);
+  std::vector<int> north, top, south, pole;
+  for (const VertexHandle v : sphere.vertices()) {
+    const double z = sphere.point(v)[2];
+    if (z > 0.5) north.push_back(v.idx());
+    if (z > 0.95) top.push_back(v.idx());
+    if (z < -0.5) south.push_back(v.idx());
+    if (z < -0.95) pole.push_back(v.idx());
+  }
+  const Transform lift = translation({0.0, 0.0, 0.1});
+  Editor unlimited(sphere);
+  unlimited.set_region(north, {top});
+  const std::uint64_t north_bytes = region_bytes(unlimited.report().free_base_vertices, 2, 1);
+  unlimited.set_region(south, {pole});
+  const std::uint64_t south_bytes = region_bytes(unlimited.report().free_base_vertices, 2, 1);
+  unlimited.set_region(north, {top});
+  EXPECT_TRUE(unlimited.report().region_reused);
+  unlimited.set_transform(0, lift);
+
+  EditorOptions options;
+  options.memory_bytes = kEditorBytesPerTriangle * sphere.n_faces() +
+                         std::max(north_bytes, south_bytes) +
+                         std::min(north_bytes, south_bytes) / 2;
+  Editor limited(sphere, options);
+  limited.set_region(north, {top});
+  limited.set_region(south, {pole});
+  limited.set_region(north, {top});
+  EXPECT_FALSE(limited.report().region_reused);
+  limited.set_transform(0, lift);
+  EXPECT_EQ(limited.positions(), unlimited.positions());
 }
 
 TEST(Limits, UnionsNestAtMost32Deep) {

@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <limits>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -69,6 +70,123 @@ TEST(ServerEditing, ANewKKeepsTheMoveWithoutABakeAndUndoComesBack) {
   EXPECT_TRUE(json::parse(call(s, "POST", "/api/undo").body)["changed"]);
   EXPECT_EQ(as<float>(call(s, "GET", "/api/mesh/positions")), k2);
   EXPECT_EQ(status_of(s)["region"]["k"], 2);
+}
+
+/// A bumpy sphere of about 10k vertices as OFF text: its set_region takes long enough for a
+/// newer region to arrive while it runs.
+std::string large_sphere_off() {
+  Mesh m = make_icosphere(5, 1.0);
+  std::ostringstream out;
+  out.precision(17);
+  out << "OFF\n" << m.n_vertices() << " " << m.n_faces() << " 0\n";
+  for (const VertexHandle v : m.vertices()) {
+    const Vec3 p = m.point(v) * (1.0 + 0.02 * std::sin(11 * m.point(v)[0]));
+    out << p[0] << " " << p[1] << " " << p[2] << "\n";
+  }
+  for (const FaceHandle f : m.faces()) {
+    out << 3;
+    for (const VertexHandle v : m.fv_range(f)) out << " " << v.idx();
+    out << "\n";
+  }
+  return out.str();
+}
+
+/// The vertices above height z, and those above z_handle, of positions (x, y, z Float32).
+json cap_region(const std::vector<float>& p, double z, double z_handle) {
+  std::vector<int> support, handle;
+  for (std::size_t v = 0; v < p.size() / 3; ++v) {
+    if (p[3 * v + 2] > z) support.push_back(static_cast<int>(v));
+    if (p[3 * v + 2] > z_handle) handle.push_back(static_cast<int>(v));
+  }
+  return {{"support", support}, {"handles", {handle}}, {"k", 2}};
+}
+
+// Regions sent while a region job runs stop it: only the last is installed (one snapshot), and
+// a stopped job never installs its region.
+TEST(ServerEditing, ANewerRegionStopsTheRunningOneAndOnlyTheLastIsInstalled) {
+  Session s;
+  ASSERT_EQ(call(s, "POST", "/api/load", large_sphere_off(), {{"name", "ball.off"}}).status, 202);
+  s.wait();
+  const auto rest = as<float>(call(s, "GET", "/api/mesh/positions"));
+  const std::vector<json> regions = {cap_region(rest, 0.0, 0.8), cap_region(rest, 0.3, 0.9),
+                                     cap_region(rest, -0.2, 0.85), cap_region(rest, 0.5, 0.95)};
+  for (const json& r : regions) ASSERT_EQ(call(s, "POST", "/api/region", r.dump()).status, 202);
+  s.wait();
+  const json status = status_of(s);
+  ASSERT_FALSE(status.contains("error")) << status;
+  EXPECT_EQ(json::parse(call(s, "GET", "/api/region").body)["support"], regions.back()["support"]);
+  EXPECT_EQ(status["region"]["support"], regions.back()["support"].size());
+  // One snapshot after the load's: undo goes straight back to no region.
+  EXPECT_TRUE(json::parse(call(s, "POST", "/api/undo").body)["changed"]);
+  EXPECT_TRUE(json::parse(call(s, "GET", "/api/region").body).is_null());
+  EXPECT_FALSE(status_of(s)["undo"]);
+}
+
+// A region job stopped after its set_region, followed by one that fails: the session keeps the
+// region it had, and its editor solves that region again (the same positions for the same move).
+TEST(ServerEditing, AFailedRegionAfterAStoppedOneLeavesTheSessionsRegion) {
+  Session s;
+  ASSERT_EQ(call(s, "POST", "/api/load", large_sphere_off(), {{"name", "ball.off"}}).status, 202);
+  s.wait();
+  const auto rest = as<float>(call(s, "GET", "/api/mesh/positions"));
+  const json first = cap_region(rest, 0.2, 0.9);
+  ASSERT_EQ(call(s, "POST", "/api/region", first.dump()).status, 202);
+  s.wait();
+  const std::vector<double> lift = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0.3};
+  const auto moved = as<float>(move(s, lift));
+  ASSERT_FALSE(moved.empty());
+  ASSERT_EQ(move(s, {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0}).status, 200); // back to rest
+  // Another region, then one whose handle lies outside its support (refused by set_region).
+  ASSERT_EQ(call(s, "POST", "/api/region", cap_region(rest, -0.3, 0.7).dump()).status, 202);
+  json bad = cap_region(rest, 0.6, 0.9);
+  bad["handles"] = json::array({cap_region(rest, -0.9, -0.8)["handles"][0]});
+  ASSERT_EQ(call(s, "POST", "/api/region", bad.dump()).status, 202);
+  s.wait();
+  const json status = status_of(s);
+  ASSERT_TRUE(status.contains("error")) << status;
+  EXPECT_NE(status["error"].get<std::string>().find("outside the support"), std::string::npos);
+  EXPECT_EQ(json::parse(call(s, "GET", "/api/region").body)["support"], first["support"]);
+  EXPECT_EQ(as<float>(move(s, lift)), moved);
+}
+
+// A new region after a move bakes the edited shape locally (only around the move), and undo and
+// redo through several such bakes give back every state's positions bit for bit.
+TEST(ServerEditing, UndoAndRedoThroughLocalBakesAreExact) {
+  Session s;
+  ASSERT_EQ(call(s, "POST", "/api/load", sphere_off(5), {{"name", "fine.off"}}).status, 202);
+  s.wait();
+  const auto rest = as<float>(call(s, "GET", "/api/mesh/positions"));
+  std::vector<int> support, handle;
+  for (std::size_t v = 0; v < rest.size() / 3; ++v) {
+    if (rest[3 * v + 2] > 0.85) support.push_back(static_cast<int>(v));
+    if (rest[3 * v + 2] > 0.97) handle.push_back(static_cast<int>(v));
+  }
+  // The positions of every state of the history: the load, then per round the region (the shape
+  // as baked) and the move.
+  std::vector<std::vector<float>> steps{rest};
+  for (int i = 0; i < 3; ++i) {
+    const json region = {{"support", support}, {"handles", {handle}}, {"k", 2}};
+    ASSERT_EQ(call(s, "POST", "/api/region", region.dump()).status, 202);
+    s.wait();
+    const json status = status_of(s);
+    ASSERT_FALSE(status.contains("error")) << status;
+    if (i > 0) {
+      EXPECT_TRUE(status["base"]["bake"]["local"].get<bool>()) << status["base"];
+    }
+    steps.push_back(as<float>(call(s, "GET", "/api/mesh/positions")));
+    const double lift = i % 2 == 0 ? 0.1 : -0.05;
+    ASSERT_EQ(move(s, {1, 0, 0, 0, 0, 1, 0, 0.05 * i, 0, 0, 1, lift}).status, 200);
+    call(s, "POST", "/api/commit");
+    steps.push_back(as<float>(call(s, "GET", "/api/mesh/positions")));
+  }
+  for (std::size_t k = steps.size() - 1; k-- > 0;) {
+    ASSERT_TRUE(json::parse(call(s, "POST", "/api/undo").body)["changed"]);
+    EXPECT_EQ(as<float>(call(s, "GET", "/api/mesh/positions")), steps[k]) << "undo to step " << k;
+  }
+  for (std::size_t k = 1; k < steps.size(); ++k) {
+    ASSERT_TRUE(json::parse(call(s, "POST", "/api/redo").body)["changed"]);
+    EXPECT_EQ(as<float>(call(s, "GET", "/api/mesh/positions")), steps[k]) << "redo to step " << k;
+  }
 }
 
 TEST(ServerEditing, MirrorsCollapsesAndNumbersOutOfRangeAreRefused) {

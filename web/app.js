@@ -34,7 +34,7 @@ const { orbit, gizmo, pivot } = view;
 // ---- state --------------------------------------------------------------------------------------
 const MIN_SCALE = 0.05; // the manipulator's smallest scale per axis: the map keeps det(M) > 0
 const state = {
-  tool: 'orbit', selected: 0, handleCount: 1, k: 2,
+  tool: 'orbit', selected: 0, handleCount: 1, k: 2, method: 'linear', converged: true,
   labels: null, positions: null, indices: null, // labels: FIXED, FREE or a handle index per vertex
   movable: null, sentMovable: null, serverHandles: 0, transforms: [], dirtyRegion: false, status: null, frameMs: undefined,
   held: { mesh: undefined, positions: undefined, region: undefined }, // the status ids of what the page holds
@@ -92,6 +92,8 @@ async function fetchRegion(s, labelsKnown) {
       region.handles.forEach((h, j) => { for (const v of h) state.labels[v] = j; });
       state.k = region.k;
       panels.setK(region.k);
+      state.method = region.method ?? 'linear';
+      panels.setMethod(state.method);
     }
     state.handleCount = Math.max(1, region?.handles.length ?? 0);
     state.selected = Math.min(state.selected, state.handleCount - 1);
@@ -134,7 +136,7 @@ function paint(ids, tool, label) {
     if (tool === 'support' && old >= 0) continue; // painting the support keeps handles
     if (old !== label) { state.labels[v] = label; touched.push(v); }
   }
-  if (touched.length) { state.dirtyRegion = true; view.colour(state.labels, touched); }
+  if (touched.length) { state.dirtyRegion = true; view.colour(state.labels, touched); if (painting) strokeChanged(); }
 }
 
 function submitPick(event, paintIt) {
@@ -162,12 +164,27 @@ window.addEventListener('pointerup', () => {
   if (!painting) return;
   painting = false;
   orbit.enabled = true;
+  clearTimeout(pauseTimer);
   state.marks.strokeEnd = performance.now();
   task(async () => {
     await picks.idle();
     if (state.dirtyRegion) await sendRegion();
+    else if (regionSent) await regionSent.then(regionShown); // sent in a pause of the stroke
   });
 });
+
+// The region's work hides behind the brush: when a stroke pauses (the pointer held still for
+// PAUSE_MS), the region as painted so far goes to the server, which solves it while the user
+// looks; a later change sends it again, and the server stops the stale job for it. At mouse-up
+// nothing is left to send when nothing changed since.
+const PAUSE_MS = 250;
+let pauseTimer = 0, regionSent = null;
+function strokeChanged() {
+  clearTimeout(pauseTimer);
+  pauseTimer = setTimeout(() => {
+    if (painting && state.dirtyRegion) task(() => sendRegion({ inStroke: true }));
+  }, PAUSE_MS);
+}
 
 /// The painted region as the API takes it; handles are renumbered so that none is empty (the
 /// labels follow), and `free` counts the support's vertices outside every handle.
@@ -200,57 +217,90 @@ function regionLists() {
 }
 
 /// Sends the painted region when it can be solved; otherwise says what is missing. A refusal
-/// (a 4xx or the job's error) keeps the paint and shows the server's message.
-async function sendRegion({ keepGizmo = false } = {}) {
-  const started = performance.now();
+/// (a 4xx or the job's error) keeps the paint and shows the server's message. A region sent
+/// while the server solves an older one replaces it (the server stops the older job); only the
+/// newest send brings the page up to the result. inStroke: sent in a pause of a stroke (no
+/// hints, the tool stays); keepGizmo: a new k under the same region.
+let regionSeq = 0;
+async function sendRegion({ keepGizmo = false, inStroke = false } = {}) {
+  const started = performance.now(), seq = ++regionSeq;
+  clearTimeout(relaxTimer);
+  relaxTimer = null;
   state.dirtyRegion = false;
   const { support, handles, free } = regionLists();
   showHandleButtons();
-  if (!handles.length) {
-    message(support.length ? 'Now paint a handle inside the support (tool "Handle", H).'
-                           : 'Paint a support (S), then a handle inside it (H).', 'hint');
+  if (!handles.length || !free) {
+    regionSent = null;
+    if (inStroke) return;
+    if (!handles.length)
+      message(support.length ? 'Now paint a handle inside the support (tool "Handle", H).'
+                             : 'Paint a support (S), then a handle inside it (H).', 'hint');
+    else message('The support has no free vertex: paint the support around the handle (tool "Support", S).', 'hint');
     return;
   }
-  if (!free) {
-    message('The support has no free vertex: paint the support around the handle (tool "Support", S).', 'hint');
-    return;
-  }
-  if (busy()) await settle();
+  if (busy() && state.status?.progress?.job !== 'region') await settle(); // a load: wait for it
   const steps = { started, lists: performance.now() };
-  const posted = post('region', { support, handles, k: state.k });
+  const posted = post('region', { support, handles, k: state.k, method: state.method });
   // While the request travels and the server solves: the normal plan of the region sent (its
   // movable vertices are the support, handles included, sorted).
   state.sentMovable = Uint32Array.from(support);
   view.setMovable(state.sentMovable);
   steps.planned = performance.now();
-  try {
-    panels.showProgress(await (await posted).json());
-  } catch (e) {
+  const outcome = (async () => {
+    try {
+      panels.showProgress(await (await posted).json());
+    } catch (e) {
+      return { failed: true };
+    }
+    steps.posted = performance.now();
+    const s = await settle();
+    steps.settled = performance.now();
+    return { s };
+  })();
+  // Resolves once the page holds the result (only the newest send brings the page up to it).
+  const sent = (async () => {
+    const result = { ...(await outcome), seq, steps, keepGizmo };
+    if (seq === regionSeq) await regionArrived(result);
+    return result;
+  })();
+  regionSent = sent;
+  const result = await sent;
+  if (!inStroke && !painting) regionShown(result);
+}
+
+/// Brings the page up to a region's result (or back to the region it had, on a refusal).
+async function regionArrived({ failed, s, keepGizmo }) {
+  if (failed || s.error) {
     state.sentMovable = null;
     view.setMovable(state.movable);
-    return;
-  }
-  steps.posted = performance.now();
-  const s = await settle();
-  steps.settled = performance.now();
-  if (s.error) {
-    state.sentMovable = null;
-    view.setMovable(state.movable);
-    state.status = s;
-    panels.showStats(s, state.frameMs);
+    if (s) {
+      state.status = s;
+      panels.showStats(s, state.frameMs);
+    }
     state.dirtyRegion = true;
     placeGizmo(true);
     return;
   }
   await sync(s, { labelsKnown: true, keepGizmo });
   state.sentMovable = null;
+}
+
+/// After the stroke: the manipulator on the region (the Orbit tool), and the marks of the
+/// benchmark.
+function regionShown({ failed, s, steps, keepGizmo, seq }) {
+  if (failed || s?.error || seq !== regionSeq || painting) return;
+  regionSent = null;
   state.marks.regionReady.push(performance.now());
-  for (const key of Object.keys(steps)) steps[key] -= state.marks.strokeEnd;
-  state.marks.regionSteps.push(steps);
-  if (!keepGizmo) {
-    setTool('orbit');
-    message('Region ready; the Orbit tool is on: drag the arrows to move the handle (S, H: paint again).', 'info');
+  const relative = { ...steps };
+  for (const key of Object.keys(relative)) relative[key] -= state.marks.strokeEnd;
+  state.marks.regionSteps.push(relative);
+  if (keepGizmo) {
+    placeGizmo(true);
+    return;
   }
+  setTool('orbit');
+  placeGizmo(); // on the handle of this region
+  message('Region ready; the Orbit tool is on: drag the arrows to move the handle (S, H: paint again).', 'info');
 }
 
 // ---- handles and the manipulator ----------------------------------------------------------------
@@ -293,19 +343,49 @@ function matrixToRows(m) {
   return [e[0], e[4], e[8], e[12], e[1], e[5], e[9], e[13], e[2], e[6], e[10], e[14]];
 }
 
+// A frame: a handle's new map (POST transform), or for the nonlinear method more iterations under
+// the same maps while the pointer rests (POST relax). The answer is the movable vertices' positions.
+const RELAX_PAUSE_MS = 120, RELAX_BUDGET_MS = 40;
 async function sendFrame(request) {
-  const response = await api('transform', { method: 'POST', headers: { 'Content-Type': 'application/json' },
-                                            body: JSON.stringify({ handle: request.handle, matrix: request.matrix }) });
+  // A refused relax (the server busy with a new region) is dropped without a message.
+  const response = request.relax
+    ? await fetch('api/relax', { method: 'POST', headers: { 'Content-Type': 'application/json' },
+                                 body: JSON.stringify({ budget_ms: RELAX_BUDGET_MS }) })
+    : await api('transform', { method: 'POST', headers: { 'Content-Type': 'application/json' },
+                               body: JSON.stringify({ handle: request.handle, matrix: request.matrix }) });
+  if (!response.ok) throw new ApiError(response.status, 'relax refused');
   const buffer = await response.arrayBuffer();
-  return { moved: new Float32Array(buffer), bytes: buffer.byteLength, ms: parseFloat(response.headers.get('X-Frame-Ms')) };
+  return { moved: new Float32Array(buffer), bytes: buffer.byteLength, ms: parseFloat(response.headers.get('X-Frame-Ms')),
+           converged: response.headers.get('X-Converged') !== '0' };
 }
+let lastMove = 0, relaxTimer = null;
 const frames = new Coalescer(sendFrame, (result, request) => {
   if (!state.movable || result.moved.length !== 3 * state.movable.length) return;
   state.frameMs = result.ms;
   view.applyMoved(state.movable, result.moved);
-  state.marks.drag.push(performance.now() - request.t0);
-  state.marks.dragBytes.push(result.bytes);
+  if (!request.relax) {
+    state.marks.drag.push(performance.now() - request.t0);
+    state.marks.dragBytes.push(result.bytes);
+  }
+  state.converged = result.converged;
+  if (!result.converged) relaxSoon();
+  else if (request.relax) task(refreshStatus);
 });
+/// While the nonlinear iteration is not converged: once the pointer has rested RELAX_PAUSE_MS,
+/// ask for more iterations (a newer move replaces a waiting relax request).
+function relaxSoon() {
+  clearTimeout(relaxTimer);
+  const wait = Math.max(0, lastMove + RELAX_PAUSE_MS - performance.now());
+  relaxTimer = setTimeout(() => {
+    relaxTimer = null;
+    if (!frames.pending && performance.now() - lastMove >= RELAX_PAUSE_MS) frames.submit({ relax: true });
+    else if (!frames.pending) relaxSoon();
+  }, wait);
+}
+async function refreshStatus() {
+  try { state.status = await json('status'); panels.showStats(state.status, state.frameMs); } catch (e) { /* shown */ }
+  if (state.status?.nonlinear?.fallback) message(state.status.nonlinear.fallback, 'hint');
+}
 
 let dragStart = null, dragBase = null;
 gizmo.addEventListener('dragging-changed', (event) => {
@@ -330,7 +410,8 @@ gizmo.addEventListener('objectChange', () => {
   pivot.updateMatrix();
   const t = pivot.matrix.clone().multiply(dragStart).multiply(dragBase);
   state.transforms[state.selected] = t;
-  frames.submit({ handle: state.selected, matrix: matrixToRows(t), t0: performance.now() });
+  lastMove = performance.now();
+  frames.submit({ handle: state.selected, matrix: matrixToRows(t), t0: lastMove });
 });
 
 // ---- the base surface ---------------------------------------------------------------------------
@@ -379,6 +460,10 @@ function setK(k) {
   state.k = k;
   if (state.movable && state.labels && !painting) task(() => sendRegion({ keepGizmo: true }));
 }
+function setMethod(method) {
+  state.method = method;
+  if (state.movable && state.labels && !painting) task(() => sendRegion({ keepGizmo: true }));
+}
 async function history(which) {
   if (busy() || frames.busy || painting) return;
   message('');
@@ -397,7 +482,7 @@ async function upload(file) {
   message(`Loaded ${file.name}. Paint a support (S), then a handle inside it (H).`, 'info');
 }
 panels.bindPanels({
-  setTool, setMode, newHandle, clear, setK, showMesh,
+  setTool, setMode, newHandle, clear, setK, setMethod, showMesh,
   history: (which) => task(() => history(which)),
   showBase: () => task(() => showBase(false)),
   upload: (file) => task(() => upload(file)),
@@ -448,7 +533,10 @@ window.remora = {
     for (let i = 0; i < n.length; i += 3) worst = Math.max(worst, 1 - Math.max(Math.abs(n[i]), Math.abs(n[i + 1]), Math.abs(n[i + 2])));
     return worst;
   },
-  ready: () => !!view.shown.mesh && work.tasks === 0 && !frames.busy && !picks.busy && state.status?.state === 'ready',
+  ready: () => !!view.shown.mesh && work.tasks === 0 && !frames.busy && relaxTimer === null && !picks.busy &&
+               state.status?.state === 'ready',
+  converged: () => state.converged,
+  method: () => state.method,
   setTool, setMode,
 };
 

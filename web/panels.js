@@ -1,4 +1,4 @@
-// The panel: tool, mode and handle buttons, the brush radius, k, undo/redo, the view toggles,
+// The panel: tool, mode and handle buttons, the brush radius, k, the method, undo/redo, the view toggles,
 // export, the stats and the progress bar, and the keyboard. It calls back into app.js through the
 // `actions` given to bindPanels() and holds no state of the edit.
 import { api, message, task } from './api.js';
@@ -33,6 +33,7 @@ export function scaleRadius(factor) {
 export const brush = () => ($('geodesic').checked ? 'geodesic' : 'sphere');
 
 export function setK(k) { $('k').value = String(k); }
+export function setMethod(method) { $('method').value = method; }
 
 /// The H1, H2, … buttons: `count` handles, `selected` highlighted; onSelect(j) on a click.
 export function showHandles(count, selected, onSelect) {
@@ -60,8 +61,10 @@ export function showStats(s, frameMs) {
     lines.push(`area spread ${s.base.area_rel_mad.toFixed(3)}, smallest angle ${s.base.min_angle_deg.toFixed(1)}°`);
   }
   if (s.region) {
-    lines.push(`support ${s.region.support.toLocaleString()}, ${s.region.handles} handle(s), k = ${s.region.k}`);
+    lines.push(`support ${s.region.support.toLocaleString()}, ${s.region.handles} handle(s), k = ${s.region.k}, ${s.region.method ?? 'linear'}`);
     lines.push(`set_region ${s.region.set_region_ms.toFixed(0)} ms, frame ${(frameMs ?? s.frame_ms ?? 0).toFixed(1)} ms`);
+    const n = s.nonlinear;
+    if (n) lines.push(n.fallback ? 'nonlinear: fell back to linear' : `nonlinear: ${n.converged ? 'converged' : 'iterating'}, ${n.iterations} iterations`);
   }
   $('stats').textContent = lines.join('\n');
   setBusy(s.state === 'busy', s);
@@ -125,7 +128,7 @@ function onKey(event, actions) {
 }
 
 /// Connects the panel's controls and the keyboard to `actions` (app.js): setTool, setMode,
-/// newHandle, clear, setK, history('undo' | 'redo'), showBase, showMesh, upload(file),
+/// newHandle, clear, setK, setMethod, history('undo' | 'redo'), showBase, showMesh, upload(file),
 /// scaleRadius(factor), meshName().
 export function bindPanels(actions) {
   for (const b of document.querySelectorAll('#tools button')) b.onclick = () => actions.setTool(b.dataset.tool);
@@ -134,6 +137,7 @@ export function bindPanels(actions) {
   $('new-handle').onclick = actions.newHandle;
   $('clear').onclick = actions.clear;
   $('k').onchange = () => actions.setK(parseInt($('k').value, 10));
+  $('method').onchange = () => actions.setMethod($('method').value);
   $('undo').onclick = () => actions.history('undo');
   $('redo').onclick = () => actions.history('redo');
   $('show-base').onchange = actions.showBase;

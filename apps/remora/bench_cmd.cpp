@@ -367,6 +367,7 @@ void add_bench_command(CLI::App& app) {
   add_bench_edit_command(*bench);
   add_bench_serve_command(*bench);
   add_bench_pipeline_command(*bench);
+  add_bench_bake_command(*bench);
   auto* cmd = bench->add_subcommand(
       "solvers", "The paper's Table 1: every solver on the thin-plate system of geodesic supports");
   auto a = std::make_shared<SolversArgs>();

@@ -27,14 +27,17 @@ namespace {
 struct BenchEditArgs {
   std::string mesh = std::string(REMORA_REPO_DATA) + "/bunny.ply";
   int support = 31000, frames = 60, k = 2, threads = 0;
-  std::string solver;
+  std::string solver, method = "linear";
+  double frame_budget_ms = 6.0;
   bool json = false;
 };
 
 struct BenchEditTimes {
   double load_ms = 0, preprocess_ms = 0, set_region_ms = 0;
   std::vector<double> frames;                ///< sorted
-  std::map<std::string, double> frame_parts; ///< medians of blend, normals, decode
+  std::map<std::string, double> frame_parts; ///< medians of blend, normals, decode (nonlinear)
+  double converge_ms = 0;                    ///< nonlinear: after the last frame, to converged
+  int converge_iterations = 0;
 };
 
 /// A geodesic support around the vertex nearest the centroid, sized so that about `support`
@@ -51,9 +54,11 @@ void set_geodesic_region(Editor& editor, int support) {
   editor.set_region(order, {handle});
 }
 
-/// positions() after each of `count` handle moves (a lift and a turn), in milliseconds, sorted;
-/// the medians of the frame's parts (blend, normals, decode) go to `parts`.
-std::vector<double> time_frames(Editor& editor, int count, std::map<std::string, double>& parts) {
+/// positions(budget) after each of `count` handle moves (a lift and a turn), in milliseconds,
+/// sorted; the medians of the frame's parts (blend, normals, decode, and for the nonlinear method
+/// its iterations and their count) go to `parts`.
+std::vector<double> time_frames(Editor& editor, int count, double budget_ms,
+                                std::map<std::string, double>& parts) {
   std::map<std::string, std::vector<double>> part_times;
   const double diagonal = bounding_box_diagonal(editor.input());
   const Eigen::Vector3d center = editor.handle_center(0);
@@ -63,11 +68,14 @@ std::vector<double> time_frames(Editor& editor, int count, std::map<std::string,
     editor.set_transform(0, compose(translation(Eigen::Vector3d(0, 0.05 * s * diagonal, 0)),
                                     rotation({1, 0, 0}, 0.5 * s, center)));
     const auto t0 = Clock::now();
-    const Eigen::MatrixXd& p = editor.positions();
+    const Eigen::MatrixXd& p = editor.positions(budget_ms);
     frames.push_back(ms_since(t0));
     if (!p.allFinite()) throw NumericalError("bench edit: a frame has non-finite positions");
-    for (const char* part : {"blend", "normals", "decode"})
-      part_times[part].push_back(editor.report().milliseconds.at(std::string("frame ") + part));
+    const EditReport& r = editor.report();
+    for (const char* part : {"blend", "normals", "decode", "nonlinear"})
+      if (r.milliseconds.count(std::string("frame ") + part))
+        part_times[part].push_back(r.milliseconds.at(std::string("frame ") + part));
+    if (r.method == "nonlinear") part_times["iterations"].push_back(r.nonlinear.iterations);
   }
   std::sort(frames.begin(), frames.end());
   for (auto& [part, times] : part_times) {
@@ -88,7 +96,11 @@ void print_bench_edit(const BenchEditArgs& a, const EditReport& r, const BenchEd
                   {"frame_ms_median", median},
                   {"frame_ms_max", t.frames.back()},
                   {"frame_parts_ms_median", t.frame_parts},
-                  {"frames", t.frames.size()}};
+                  {"frames", t.frames.size()},
+                  {"method", a.method},
+                  {"frame_budget_ms", a.frame_budget_ms},
+                  {"converge_ms", t.converge_ms},
+                  {"converge_iterations", t.converge_iterations}};
     std::cout << dump_json(j, 2) << "\n";
     return;
   }
@@ -109,6 +121,12 @@ void print_bench_edit(const BenchEditArgs& a, const EditReport& r, const BenchEd
                            "frames (medians: blend {:.2f}, normals {:.2f}, decode {:.2f})\n",
                            median, t.frames.back(), t.frames.size(), t.frame_parts.at("blend"),
                            t.frame_parts.at("normals"), t.frame_parts.at("decode"));
+  if (a.method == "nonlinear")
+    std::cout << fmt::format(
+        "nonlinear: per frame (budget {:.1f} ms) median {:.2f} ms, {:.0f} iterations; after the "
+        "last frame converged in {:.0f} ms, {} iterations{}\n",
+        a.frame_budget_ms, t.frame_parts.at("nonlinear"), t.frame_parts.at("iterations"),
+        t.converge_ms, t.converge_iterations, r.fallback.empty() ? "" : " (" + r.fallback + ")");
 }
 
 void run_bench_edit(const BenchEditArgs& a) {
@@ -120,6 +138,7 @@ void run_bench_edit(const BenchEditArgs& a) {
   options.system.k = a.k;
   options.solver.name = a.solver;
   options.threads = a.threads;
+  options.method = parse_edit_method(a.method);
   ProgressLine progress;
   options.progress = [&](std::string_view phase, int step, int steps) {
     progress.update(phase, step, steps);
@@ -131,7 +150,16 @@ void run_bench_edit(const BenchEditArgs& a) {
   t0 = Clock::now();
   set_geodesic_region(editor, a.support);
   t.set_region_ms = ms_since(t0);
-  t.frames = time_frames(editor, a.frames, t.frame_parts);
+  t.frames = time_frames(editor, a.frames, a.frame_budget_ms, t.frame_parts);
+  // The drag stops: the nonlinear iteration goes on to convergence.
+  int iterations = 0;
+  t0 = Clock::now();
+  while (!editor.converged()) {
+    editor.positions(a.frame_budget_ms);
+    iterations += editor.report().nonlinear.iterations;
+  }
+  t.converge_ms = ms_since(t0);
+  t.converge_iterations = iterations;
   print_bench_edit(a, editor.report(), t);
 }
 
@@ -150,6 +178,11 @@ void add_bench_edit_command(CLI::App& bench) {
       ->check(CLI::PositiveNumber);
   cmd->add_option("--k", a->k, "Order k (default 2)")->check(CLI::Range(1, 3));
   cmd->add_option("--solver", a->solver, "Solver (default: the direct one)");
+  cmd->add_option("--method", a->method, "linear (default) or nonlinear")
+      ->check(CLI::IsMember({"linear", "nonlinear"}));
+  cmd->add_option("--frame-budget", a->frame_budget_ms,
+                  "Nonlinear: milliseconds of iterations per frame while dragging (default 6)")
+      ->check(CLI::PositiveNumber);
   cmd->add_option("--threads", a->threads, "Worker threads (default: all)")
       ->check(CLI::NonNegativeNumber);
   cmd->add_flag("--json", a->json, "Print one JSON object");

@@ -18,5 +18,7 @@ void add_bench_edit_command(CLI::App& bench);
 void add_bench_serve_command(CLI::App& bench);
 /// `remora bench pipeline`, a subcommand of `remora bench`.
 void add_bench_pipeline_command(CLI::App& bench);
+/// `remora bench bake`, a subcommand of `remora bench`.
+void add_bench_bake_command(CLI::App& bench);
 
 } // namespace remora::cli

@@ -112,6 +112,18 @@ void print_edit_report(std::ostream& os, const EditReport& r, double load_ms, do
   os << fmt::format("details: {} encoded, {} walk steps, {} extrapolated, {} fallbacks\n",
                     grouped(r.phong.encoded), grouped(r.phong.walk_steps),
                     grouped(r.phong.extrapolated), grouped(r.phong.fallbacks));
+  if (r.method == "nonlinear") {
+    const NonlinearStats& n = r.nonlinear;
+    if (!r.fallback.empty())
+      os << "deformation: nonlinear, " << r.fallback << "\n";
+    else
+      os << fmt::format("deformation: nonlinear, {} iterations ({} extrapolated), {}, energy "
+                        "{:.4g} -> {:.4g}\n",
+                        n.total_iterations, n.accelerated,
+                        n.converged ? "converged" : "not converged (max_iterations)",
+                        n.energy.empty() ? 0.0 : n.energy.front(),
+                        n.energy.empty() ? 0.0 : n.energy.back());
+  }
   os << fmt::format("result: largest move {:.4g} of the bounding-box diagonal, detail retention "
                     "{:.3f}\n",
                     max_move, retention);
@@ -130,7 +142,7 @@ struct EditArgs {
   std::string in, out, edit;
   std::string support_sphere, handle_sphere, translate, rotate, scale;
   int k = 0, threads = 0;
-  std::string solver, areas, details;
+  std::string solver, areas, details, method;
   double base_smoothing = -1, base_feature_cap = -1, length_factor = -1;
   bool no_remesh = false, report = false, json = false;
   std::uint64_t max_triangles = 0;
@@ -166,6 +178,9 @@ void add_edit_options(CLI::App* cmd, EditArgs& a) {
       ->check(CLI::IsMember({"mean", "mixed", "mixed-symmetric"}));
   cmd->add_option("--details", a.details, "normal (default, Phong), displacement, none")
       ->check(CLI::IsMember({"normal", "displacement", "none"}));
+  cmd->add_option("--method", a.method,
+                  "linear (default, the paper) or nonlinear (keeps rotated parts from shrinking)")
+      ->check(CLI::IsMember({"linear", "nonlinear"}));
   cmd->add_option("--base-smoothing", a.base_smoothing,
                   "Low-pass length of the base surface, in mean edge lengths (area-based on needle "
                   "meshes; default 2)")
@@ -244,6 +259,7 @@ EditorOptions editor_options(const EditRequest& request, const EditArgs& a) {
   if (!a.solver.empty()) options.solver.name = a.solver;
   if (!a.areas.empty()) options.system.areas = parse_area_weights(a.areas);
   if (!a.details.empty()) options.details = parse_detail_mode(a.details);
+  if (!a.method.empty()) options.method = parse_edit_method(a.method);
   if (a.base_smoothing >= 0) options.base.smoothing = a.base_smoothing;
   if (a.base_feature_cap >= 0) options.base.feature_cap = a.base_feature_cap;
   if (a.length_factor > 0) options.remesh_options.length_factor = a.length_factor;

@@ -35,7 +35,7 @@ void add_serve_command(CLI::App& app) {
   struct Args {
     std::string mesh, host = "127.0.0.1", web_root = REMORA_WEB_ROOT;
     int port = 8080, threads = 0, max_handles = kMaxHandles, history_editors = 3;
-    double max_upload_mb = 256;
+    double max_upload_mb = 256, frame_budget_ms = 6.0;
     std::uint64_t max_triangles = 0;
   };
   auto a = std::make_shared<Args>();
@@ -48,6 +48,9 @@ void add_serve_command(CLI::App& app) {
       ->check(CLI::PositiveNumber);
   cmd->add_option("--threads", a->threads, "Editor threads (default: all)")
       ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--frame-budget", a->frame_budget_ms,
+                  "Method nonlinear: milliseconds of iterations per handle move (default 6)")
+      ->check(CLI::PositiveNumber);
   cmd->add_option("--history-editors", a->history_editors,
                   "Editors (one per bake) the undo history keeps alive (default 3); fewer raise "
                   "the default --max-triangles")
@@ -71,6 +74,7 @@ void add_serve_command(CLI::App& app) {
         editor_memory_share(physical_memory_bytes(), a->history_editors + 1);
     options.read.max_triangles = a->max_triangles;
     options.max_handles = a->max_handles;
+    options.frame_budget_ms = a->frame_budget_ms;
     server::Session session(options);
     server::ApiLimits limits;
     limits.max_upload_bytes = static_cast<std::size_t>(a->max_upload_mb * 1024 * 1024);

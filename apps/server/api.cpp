@@ -94,9 +94,10 @@ void only_keys(const json& j, std::initializer_list<const char*> keys) {
 
 HttpResponse region(Session& session, const HttpRequest& request, const ApiLimits& limits) {
   const json j = parse_json(request, limits);
-  only_keys(j, {"support", "handles", "k"});
+  only_keys(j, {"support", "handles", "k", "method"});
   if (!j.contains("support") || !j.contains("handles"))
-    throw BadRequest("expected {\"support\": [ids], \"handles\": [[ids], ...], \"k\": 1|2|3}");
+    throw BadRequest("expected {\"support\": [ids], \"handles\": [[ids], ...], \"k\": 1|2|3, "
+                     "\"method\": \"linear\"|\"nonlinear\"}");
   std::vector<int> support = ids(j.at("support"), "support");
   const json& hs = j.at("handles");
   if (!hs.is_array()) throw BadRequest("handles: expected an array of arrays of vertex ids");
@@ -108,10 +109,26 @@ HttpResponse region(Session& session, const HttpRequest& request, const ApiLimit
     if (!j.at("k").is_number_integer()) throw BadRequest("k: expected 1, 2 or 3");
     k = j.at("k").get<int>();
   }
+  EditMethod method = EditMethod::Linear;
+  if (j.contains("method")) {
+    if (!j.at("method").is_string())
+      throw BadRequest("method: expected \"linear\" or \"nonlinear\"");
+    method = parse_edit_method(j.at("method").get<std::string>());
+  }
   if (support.empty()) throw BadRequest("the support is empty: paint at least one vertex");
   if (handles.empty()) throw BadRequest("no handle: paint a handle inside the support");
-  session.start_region(std::move(support), std::move(handles), k);
+  session.start_region(std::move(support), std::move(handles), k, method);
   return json_response(202, session.status());
+}
+
+/// A frame's positions as Float32 with its figures in headers: X-Frame-Ms (the server's time),
+/// X-Converged (1, or 0 while method nonlinear still iterates), X-Iterations.
+HttpResponse frame_response(const Frame& f) {
+  HttpResponse r = binary_response(f.positions);
+  r.headers["X-Frame-Ms"] = fmt::format("{:.3f}", f.ms);
+  r.headers["X-Converged"] = f.converged ? "1" : "0";
+  r.headers["X-Iterations"] = std::to_string(f.iterations);
+  return r;
 }
 
 HttpResponse transform(Session& session, const HttpRequest& request, const ApiLimits& limits) {
@@ -130,10 +147,24 @@ HttpResponse transform(Session& session, const HttpRequest& request, const ApiLi
         throw BadRequest(fmt::format("matrix[{}]: expected a finite number", 4 * r + c));
       t(r, c) = x.get<double>();
     }
-  double frame_ms = 0;
-  HttpResponse r = binary_response(session.set_transform(j.at("handle").get<int>(), t, &frame_ms));
-  r.headers["X-Frame-Ms"] = fmt::format("{:.3f}", frame_ms);
-  return r;
+  return frame_response(session.set_transform(j.at("handle").get<int>(), t));
+}
+
+/// POST /api/relax {"budget_ms": B}: method nonlinear goes on iterating under the live
+/// transforms for at most B milliseconds (default 50).
+HttpResponse relax(Session& session, const HttpRequest& request, const ApiLimits& limits) {
+  double budget = 50.0;
+  if (!request.body.empty()) {
+    const json j = parse_json(request, limits);
+    only_keys(j, {"budget_ms"});
+    if (j.contains("budget_ms")) {
+      const json& b = j.at("budget_ms");
+      if (!b.is_number() || !(b.get<double>() > 0.0) || !(b.get<double>() <= 10000.0))
+        throw BadRequest("budget_ms: expected milliseconds above 0, at most 10000");
+      budget = b.get<double>();
+    }
+  }
+  return frame_response(session.relax(budget));
 }
 
 /// A 3-vector of finite numbers at `key`.
@@ -229,6 +260,7 @@ HttpResponse dispatch(Session& session, const HttpRequest& q, const ApiLimits& l
   if (p == "/api/region" && get) return json_response(200, session.region());
   if (p == "/api/region") return need("POST", "GET, POST"), region(session, q, limits);
   if (p == "/api/transform") return post_only(), transform(session, q, limits);
+  if (p == "/api/relax") return post_only(), relax(session, q, limits);
   if (p == "/api/pick") return post_only(), pick(session, q, limits);
   if (p == "/api/commit")
     return post_only(), session.commit(), json_response(200, session.status());

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <functional>
+#include <stop_token>
 #include <string_view>
 #include <utility>
 
@@ -12,6 +13,7 @@
 #include "remora/geometry/quality.h"
 #include "remora/linalg/kharmonic.h"
 #include "remora/mesh/io.h"
+#include "remora/multires/bake.h"
 
 namespace remora::server {
 
@@ -21,6 +23,7 @@ struct RegionKey {
   std::vector<int> support;
   std::vector<std::vector<int>> handles;
   int k = 2;
+  EditMethod method = EditMethod::Linear;
   bool operator==(const RegionKey&) const = default;
 };
 
@@ -30,6 +33,7 @@ struct EditorBox {
   Editor editor;
   std::optional<RegionKey> region;
   double preprocess_ms = 0.0;
+  std::optional<BakeReport> bake; ///< how a bake made it (none for a load)
 };
 
 struct Snapshot {
@@ -37,6 +41,16 @@ struct Snapshot {
   std::optional<RegionKey> region;
   std::vector<Transform> transforms;
 };
+
+/// The movable vertices' rows of `p` as interleaved Float32.
+std::vector<float> movable_floats(const Editor& editor, const Eigen::MatrixXd& p) {
+  const std::vector<int>& movable = editor.movable_vertices();
+  std::vector<float> out(3 * movable.size());
+  for (std::size_t i = 0; i < movable.size(); ++i)
+    for (int c = 0; c < 3; ++c)
+      out[3 * i + static_cast<std::size_t>(c)] = static_cast<float>(p(movable[i], c));
+  return out;
+}
 
 bool is_identity(const std::vector<Transform>& transforms) {
   for (const Transform& t : transforms)
@@ -49,6 +63,7 @@ bool is_identity(const std::vector<Transform>& transforms) {
 /// the remesh); the bar moves forward, it does not promise a time.
 std::pair<double, double> preprocess_share(std::string_view phase) {
   if (phase == "reading") return {0.0, 0.05};
+  if (phase == "bake") return {0.0, 1.0}; // a local bake; a full one reports the phases below
   if (phase == "base surface") return {0.05, 0.2};
   if (phase == "remesh: remesh") return {0.2, 0.6};
   if (phase == "remesh: equalize") return {0.6, 0.9};
@@ -64,6 +79,14 @@ struct Session::Impl {
   std::condition_variable idle;
   std::thread worker;
   bool busy = false;
+  // The running job's stop request, and the job queued behind it: a new region while a region
+  // job runs stops that job (set_region checks between its steps) and runs next.
+  std::stop_source stop;
+  std::function<void(std::stop_token)> pending;
+  // A bake kept for the next region job when a newer region stopped the job after its bake: the
+  // same editor under the same transforms bakes into the same shape.
+  std::shared_ptr<EditorBox> baked, baked_from;
+  std::vector<Transform> baked_transforms;
   std::string job;   // what the worker does ("load", "region")
   std::string phase; // its current phase
   int step = 0, steps = 0;
@@ -115,6 +138,7 @@ struct Session::Impl {
     transforms = s.transforms;
     if (region && box->region != region) {
       box->editor.set_system({region->k, box->editor.options().system.areas});
+      box->editor.set_method(region->method);
       box->editor.set_region(region->support, region->handles);
       box->region = region;
     }
@@ -137,27 +161,146 @@ struct Session::Impl {
     const double within = n > 0 ? std::clamp(double(s) / n, 0.0, 1.0) : 0.0;
     fraction = span_begin + (span_end - span_begin) * (begin + (end - begin) * within);
   }
-  void run(std::string what, std::function<void()> work) {
-    if (busy) throw Busy(fmt::format("the session is busy ({}: {})", job, phase));
+  /// Runs `work` on the worker. While a region job runs, another region job stops it and is
+  /// queued behind it (replacing one queued already); any other overlap throws Busy. Call under
+  /// the lock.
+  void run(std::string what, std::function<void(std::stop_token)> work) {
+    if (busy) {
+      if (what == "region" && job == "region") {
+        stop.request_stop();
+        pending = std::move(work);
+        return;
+      }
+      throw Busy(fmt::format("the session is busy ({}: {})", job, phase));
+    }
     if (worker.joinable()) worker.join();
     busy = true;
     job = std::move(what);
+    begin_job();
+    worker = std::thread([this, work = std::move(work), token = stop.get_token()]() mutable {
+      for (;;) {
+        try {
+          work(token);
+        } catch (const Cancelled&) {
+          // A newer region stopped it: that one runs next.
+        } catch (const std::exception& e) {
+          std::lock_guard lock(mutex);
+          error = e.what();
+        }
+        std::lock_guard lock(mutex);
+        if (pending) {
+          work = std::move(pending);
+          pending = nullptr;
+          begin_job();
+          token = stop.get_token();
+          continue;
+        }
+        busy = false;
+        phase.clear();
+        idle.notify_all();
+        return;
+      }
+    });
+  }
+  /// A job's start: a fresh stop request, no progress, no error. Call under the lock.
+  void begin_job() {
+    stop = std::stop_source();
     phase = "starting";
     step = steps = 0;
     fraction = 0.0;
     error.clear();
-    worker = std::thread([this, work = std::move(work)] {
-      try {
-        work();
-      } catch (const std::exception& e) {
-        std::lock_guard lock(mutex);
-        error = e.what();
-      }
+  }
+  /// The editor that `current` under `moved_by` bakes into (the edited shape as a new input), or
+  /// the one a stopped job made for the same bake.
+  std::shared_ptr<EditorBox> bake_once(const std::shared_ptr<EditorBox>& current,
+                                       const std::vector<Transform>& moved_by) {
+    {
       std::lock_guard lock(mutex);
-      busy = false;
-      phase.clear();
-      idle.notify_all();
-    });
+      if (baked && baked_from == current && baked_transforms == moved_by) return baked;
+    }
+    // The edited shape becomes the next input: filtered and remeshed again where the edit
+    // changed it (multires/bake.h), or in full where that cannot work.
+    const auto t0 = Clock::now();
+    BakeResult result = remora::bake(current->editor);
+    auto next = std::make_shared<EditorBox>(std::move(result.editor));
+    next->preprocess_ms = ms_since(t0);
+    next->bake = std::move(result.report);
+    std::lock_guard lock(mutex);
+    baked = next;
+    baked_from = current;
+    baked_transforms = moved_by;
+    return next;
+  }
+  /// A region job: the bake when a handle moved, the region prepared, then installed unless a
+  /// newer region stopped the job (that one runs next and installs its own): a stopped job
+  /// changes nothing.
+  /// What a region job does: bake first (a handle moved and the paint changed), solve the same
+  /// paint again under the same transforms (k or the method changed), set a new region (the
+  /// paint or k changed).
+  struct RegionWork {
+    bool bake, resolve, new_region;
+  };
+  void region_job(const RegionKey& key, RegionWork work, const std::shared_ptr<EditorBox>& current,
+                  const std::vector<Transform>& moved_by, const std::stop_token& token) {
+    {
+      std::lock_guard lock(mutex);
+      span_begin = 0.0;
+      span_end = work.bake ? 0.85 : 0.0;
+    }
+    const std::shared_ptr<EditorBox> next = work.bake ? bake_once(current, moved_by) : current;
+    progress("set_region", 0, 1);
+    // The method and k are the editor's options for set_region; a failed or stopped job puts
+    // them back, so that it leaves the session as it was.
+    Editor& editor = next->editor;
+    const KHarmonicOptions previous_system = editor.options().system;
+    const EditMethod previous_method = editor.options().method;
+    const auto restore = [&] {
+      editor.set_system(previous_system);
+      editor.set_method(previous_method);
+    };
+    std::optional<Editor::Prepared> prepared;
+    try {
+      editor.set_system({key.k, previous_system.areas});
+      editor.set_method(key.method);
+      if (work.new_region) prepared = editor.prepare_region(key.support, key.handles, token);
+    } catch (...) {
+      restore();
+      throw;
+    }
+    std::lock_guard lock(mutex);
+    if (token.stop_requested()) { // stale: the newer region is queued
+      restore();
+      return;
+    }
+    if (prepared) editor.install_region(std::move(*prepared));
+    next->region = key;
+    box = next;
+    region = key;
+    baked.reset();
+    baked_from.reset();
+    ++region_id;
+    if (work.resolve) {
+      for (std::size_t j = 0; j < moved_by.size(); ++j)
+        box->editor.set_transform(static_cast<int>(j), moved_by[j]);
+      shape->set_positions(box->editor.positions());
+      ++positions_id;
+    } else {
+      transforms.assign(key.handles.size(), identity_transform());
+    }
+    push_snapshot();
+  }
+  /// positions(budget) of the editor, as the answer to a move or a relax step. Under the lock.
+  Frame frame(double budget_ms) {
+    Editor& editor = box->editor;
+    const auto t0 = Clock::now();
+    Frame f;
+    const Eigen::MatrixXd& p = editor.positions(budget_ms);
+    f.positions = movable_floats(editor, p);
+    f.converged = editor.converged();
+    f.iterations = editor.report().method == "nonlinear" ? editor.report().nonlinear.iterations : 0;
+    f.ms = last_frame_ms = ms_since(t0);
+    shape->set_positions(editor.movable_vertices(), p);
+    return f;
   }
   /// report() under the lock, then the options' own progress callback without it. On the worker.
   void progress(std::string_view p, int s, int n) {
@@ -196,7 +339,7 @@ void Session::wait_for(std::chrono::milliseconds timeout) {
 void Session::start_load(std::string bytes, std::string name) {
   std::lock_guard lock(impl_->mutex);
   const MeshFormat format = format_from_path(name); // IoError for an unknown extension at once
-  impl_->run("load", [this, bytes = std::move(bytes), name, format] {
+  impl_->run("load", [this, bytes = std::move(bytes), name, format](std::stop_token) {
     Impl& m = *impl_;
     const auto t0 = Clock::now();
     {
@@ -223,10 +366,11 @@ void Session::start_load(std::string bytes, std::string name) {
   });
 }
 
-void Session::start_region(std::vector<int> support, std::vector<std::vector<int>> handles, int k) {
+void Session::start_region(std::vector<int> support, std::vector<std::vector<int>> handles, int k,
+                           EditMethod method) {
   std::lock_guard lock(impl_->mutex);
   Impl& m = *impl_;
-  m.require_ready();
+  if (!(m.busy && m.job == "region")) m.require_ready(); // a region job: stopped and followed
   if (k < 1 || k > 3) throw InvalidArgument(fmt::format("k = {} is not 1, 2 or 3", k));
   if (handles.size() > static_cast<std::size_t>(m.options.max_handles))
     throw InvalidArgument(fmt::format("{} handles: at most {} are accepted (remora serve "
@@ -250,68 +394,37 @@ void Session::start_region(std::vector<int> support, std::vector<std::vector<int
         throw InvalidArgument(fmt::format("handle vertex {} is out of range (the mesh has {} "
                                           "vertices)",
                                           v, n));
-  RegionKey key{std::move(support), std::move(handles), k};
-  // Only k changes: the same handles keep their transforms, solved again (no bake), so that a
-  // user compares k on the same drag.
-  const bool new_k = m.region && m.region->support == key.support &&
-                     m.region->handles == key.handles && m.region->k != key.k;
-  const bool bake = !new_k && !is_identity(m.transforms);
-  m.span_begin = 0.0;
-  m.span_end = bake ? 0.85 : 0.0;
-  m.run("region",
-        [this, key = std::move(key), bake, new_k, current = m.box, transforms = m.transforms] {
-          Impl& s = *impl_;
-          std::shared_ptr<EditorBox> box = current;
-          if (bake) {
-            // The edited shape becomes the next input: a new base, remeshed.
-            const auto t0 = Clock::now();
-            Mesh result = current->editor.result();
-            box = std::make_shared<EditorBox>(Editor(std::move(result), s.editor_options()));
-            box->preprocess_ms = ms_since(t0);
-          }
-          s.progress("set_region", 0, 1);
-          // On a copy of the key: a failure leaves the session as it was.
-          box->editor.set_system({key.k, box->editor.options().system.areas});
-          box->editor.set_region(key.support, key.handles);
-          box->region = key;
-          std::optional<Eigen::MatrixXd> moved;
-          if (new_k) {
-            for (std::size_t j = 0; j < transforms.size(); ++j)
-              box->editor.set_transform(static_cast<int>(j), transforms[j]);
-            moved = box->editor.positions();
-          }
-          std::lock_guard guard(s.mutex);
-          s.box = box;
-          s.region = key;
-          ++s.region_id;
-          if (moved) {
-            s.shape->set_positions(*moved);
-            ++s.positions_id;
-          } else {
-            s.transforms.assign(key.handles.size(), identity_transform());
-          }
-          s.push_snapshot();
-        });
+  RegionKey key{std::move(support), std::move(handles), k, method};
+  // Only k or the method changes: the same handles keep their transforms, solved again (no
+  // bake), so that a user compares them on the same drag. A new method alone needs no new
+  // set_region.
+  const bool same_paint =
+      m.region && m.region->support == key.support && m.region->handles == key.handles;
+  const bool resolve = same_paint && (m.region->k != key.k || m.region->method != key.method);
+  const bool new_region = !resolve || m.region->k != key.k;
+  const bool bake = !resolve && !is_identity(m.transforms);
+  m.run("region", [this, key = std::move(key), bake, resolve, new_region, current = m.box,
+                   moved_by = m.transforms](std::stop_token token) {
+    impl_->region_job(key, {bake, resolve, new_region}, current, moved_by, token);
+  });
 }
 
-std::vector<float> Session::set_transform(int handle, const Transform& transform,
-                                          double* frame_ms) {
+Frame Session::set_transform(int handle, const Transform& transform) {
   std::lock_guard lock(impl_->mutex);
   Impl& m = *impl_;
   m.require_region();
   m.box->editor.set_transform(handle, transform); // validates
   m.transforms[static_cast<std::size_t>(handle)] = transform;
-  const auto t0 = Clock::now();
-  const Eigen::MatrixXd& p = m.box->editor.positions();
-  const std::vector<int>& movable = m.box->editor.movable_vertices();
-  std::vector<float> out(3 * movable.size());
-  for (std::size_t i = 0; i < movable.size(); ++i)
-    for (int c = 0; c < 3; ++c)
-      out[3 * i + static_cast<std::size_t>(c)] = static_cast<float>(p(movable[i], c));
-  m.last_frame_ms = ms_since(t0);
-  m.shape->set_positions(movable, p);
-  if (frame_ms) *frame_ms = m.last_frame_ms;
-  return out;
+  return m.frame(m.options.frame_budget_ms);
+}
+
+Frame Session::relax(double budget_ms) {
+  std::lock_guard lock(impl_->mutex);
+  Impl& m = *impl_;
+  m.require_region();
+  if (!(budget_ms > 0.0) || !(budget_ms <= 10000.0))
+    throw InvalidArgument("budget_ms: expected milliseconds above 0, at most 10000");
+  return m.frame(budget_ms);
 }
 
 void Session::commit() {
@@ -368,12 +481,17 @@ nlohmann::json Session::status() const {
                {"area_rel_mad", r.base_quality.mixed_area.rel_mad},
                {"min_angle_deg", r.base_quality.angles.min_deg},
                {"symmetry_defect", r.base_symmetry_defect}};
-  j["k"] = m.box->editor.options().system.k;
+  if (m.box->bake)
+    j["base"]["bake"] = {{"local", m.box->bake->local},
+                         {"fallback", m.box->bake->fallback},
+                         {"milliseconds", m.box->bake->milliseconds}};
+  j["k"] = m.region ? m.region->k : m.box->editor.options().system.k;
   j["frame_ms"] = m.last_frame_ms;
   if (m.region) {
     j["region"] = {{"support", m.region->support.size()},
                    {"handles", m.region->handles.size()},
                    {"k", m.region->k},
+                   {"method", to_string(m.region->method)},
                    {"free_base_vertices", r.free_base_vertices},
                    {"set_region_ms",
                     r.milliseconds.count("set_region") ? r.milliseconds.at("set_region") : 0.0},
@@ -386,6 +504,10 @@ nlohmann::json Session::status() const {
       transforms.push_back(row_major);
     }
     j["transforms"] = transforms;
+    if (m.region->method == EditMethod::Nonlinear)
+      j["nonlinear"] = {{"iterations", r.nonlinear.total_iterations},
+                        {"converged", m.box->editor.converged()},
+                        {"fallback", r.fallback}};
   }
   return j;
 }
@@ -395,7 +517,10 @@ nlohmann::json Session::region() const {
   const Impl& m = *impl_;
   m.require_ready();
   if (!m.region) return nullptr;
-  return {{"support", m.region->support}, {"handles", m.region->handles}, {"k", m.region->k}};
+  return {{"support", m.region->support},
+          {"handles", m.region->handles},
+          {"k", m.region->k},
+          {"method", to_string(m.region->method)}};
 }
 
 namespace {

@@ -7,7 +7,9 @@
 // History: every load, region and committed transform is a snapshot (editor, region, k,
 // transforms). Undo and redo re-apply a snapshot; the same editor, region and transforms give the
 // same positions bit for bit. A new region after non-identity transforms first bakes the current
-// result into a new editor (the edited shape becomes the next input), as a user expects.
+// result into a new editor (the edited shape becomes the next input), as a user expects: locally,
+// only where the edit changed the shape (multires/bake.h), or in full where that cannot work.
+// The editors a history keeps share nothing they change (a bake's share the immutable filter).
 #pragma once
 
 #include <chrono>
@@ -42,12 +44,25 @@ struct SessionOptions {
   int threads = 0;               ///< editor threads (0 = all)
   ReadLimits read;               ///< what a load accepts (mesh/soup.h; 0 = no limit)
   int max_handles = kMaxHandles; ///< handles a region may have (multires/limits.h)
-  std::size_t max_history = 64;  ///< snapshots kept for undo
-  std::size_t max_editors = 3;   ///< distinct editors (one per bake) the history keeps alive
+  /// Method nonlinear: milliseconds of iterations per frame of set_transform() (at least one
+  /// iteration); relax() goes on from there.
+  double frame_budget_ms = 6.0;
+  std::size_t max_history = 64; ///< snapshots kept for undo
+  std::size_t max_editors = 3;  ///< distinct editors (one per bake) the history keeps alive
   /// Defaults for every editor the session builds. Its progress callback, if any, is called on
   /// the worker at every phase of every job ("reading", the editor's phases, "set_region"),
   /// after the session has recorded it, without the session's lock held.
   EditorOptions editor;
+};
+
+/// The answer to a handle move or a relax step: the positions of movable_vertices() (Float32
+/// x, y, z), the server's time, and for method nonlinear whether the iteration is finished and
+/// how many iterations the call made.
+struct Frame {
+  std::vector<float> positions;
+  double ms = 0.0;
+  bool converged = true;
+  int iterations = 0;
 };
 
 class Session {
@@ -62,11 +77,12 @@ public:
   /// before the memory for it is allocated. Throws Busy while other work runs.
   void start_load(std::string bytes, std::string name);
   /// Starts a new region on the worker (baking the current result first when a handle moved,
-  /// except when only k changes: then the handles keep their transforms and the new system is
-  /// solved under them). Validates first (InvalidArgument): k, ids in range, at most
-  /// max_handles handles, no list longer than the mesh has vertices. Throws Busy while other
-  /// work runs.
-  void start_region(std::vector<int> support, std::vector<std::vector<int>> handles, int k);
+  /// except when only k or the method changes: then the handles keep their transforms and the
+  /// region is solved again under them). Validates first (InvalidArgument): k, ids in range, at
+  /// most max_handles handles, no list longer than the mesh has vertices. Throws Busy while
+  /// other work runs.
+  void start_region(std::vector<int> support, std::vector<std::vector<int>> handles, int k,
+                    EditMethod method = EditMethod::Linear);
   /// Blocks until the worker is idle (tests and the CLI).
   void wait();
   /// Blocks until the worker is idle or `timeout` has passed (a client's long poll of the
@@ -74,8 +90,12 @@ public:
   void wait_for(std::chrono::milliseconds timeout);
 
   /// Moves handle j (live: not in the history until commit()). Returns the positions of
-  /// movable_vertices(), in that order, and the frame time in milliseconds.
-  std::vector<float> set_transform(int handle, const Transform& transform, double* frame_ms);
+  /// movable_vertices(), in that order. Method nonlinear iterates for frame_budget_ms.
+  Frame set_transform(int handle, const Transform& transform);
+  /// Method nonlinear: iterates for at most `budget_ms` more under the live transforms (the
+  /// page calls it while the user pauses, until converged). Method linear: the positions as
+  /// they are, converged.
+  Frame relax(double budget_ms);
   /// Records the live transforms as a snapshot (the end of a drag). No-op when nothing changed.
   void commit();
   bool undo(); ///< false when there is nothing to undo
@@ -92,7 +112,8 @@ public:
   Pick pick(const Vec3& origin, const Vec3& direction, double radius, Brush brush);
   /// The loaded file's name ("" before the first load).
   std::string name() const;
-  /// The current region as {"support": [ids], "handles": [[ids], ...], "k": k}, or null.
+  /// The current region as {"support": [ids], "handles": [[ids], ...], "k": k, "method":
+  /// "linear" | "nonlinear"}, or null.
   nlohmann::json region() const;
   /// Current positions of every vertex (Float32 x, y, z) and the faces (Uint32 triples).
   std::vector<float> positions() const;

@@ -109,21 +109,85 @@ async function kAfterMove(page, c, edit) {
   check(off < 1e-5, `k = 3 then 2 gives back the k = 2 shape without undo (off by ${off.toExponential(2)})`);
 }
 
+/// The page's positions against the server's: the largest difference.
+const pageVsServer = (page) => page.evaluate(async () => {
+  const server = new Float32Array(await (await fetch('api/mesh/positions')).arrayBuffer());
+  const held = window.remora.positionsHeld?.() ?? [];
+  let worst = held.length === server.length ? 0 : Infinity;
+  for (let i = 0; i < held.length && worst < Infinity; ++i) worst = Math.max(worst, Math.abs(held[i] - server[i]));
+  return worst;
+});
+
+/// The method switch after a move: nonlinear keeps the transforms and bends the support
+/// otherwise, converged; a drag under it is answered frame by frame and, once the pointer rests,
+/// relaxed until the server says converged, the page holding the server's positions; linear again
+/// gives back the linear shape.
+async function methodAfterMove(page, c, edit) {
+  const s0 = await c.json('status');
+  const linear = await c.floats('mesh/positions');
+  await page.selectOption('#method', 'nonlinear');
+  await ready(page);
+  const s1 = await c.json('status');
+  const moved = await c.floats('mesh/positions');
+  const inSupport = new Set(edit.region.support);
+  let change = 0, outside = 0;
+  for (let v = 0; v < linear.length / 3; ++v)
+    for (let k = 0; k < 3; ++k) {
+      const d = Math.abs(moved[3 * v + k] - linear[3 * v + k]);
+      if (inSupport.has(v)) change = Math.max(change, d); else if (d !== 0) outside += 1;
+    }
+  check(s1.region?.method === 'nonlinear' && JSON.stringify(s1.transforms) === JSON.stringify(s0.transforms) &&
+        s1.nonlinear?.converged === true && !s1.nonlinear?.fallback,
+        `the method nonlinear after a move keeps the transforms and converges (${JSON.stringify(s1.nonlinear)})`);
+  check(change > 1e-6 && outside === 0, `nonlinear bends the support otherwise (by ${change.toExponential(2)}), nothing outside it moves (${outside})`);
+  check(await pageVsServer(page) === 0, 'the page shows the nonlinear positions');
+  // A drag under nonlinear.
+  const frames0 = (await remora(page, 'marks')).drag.length;
+  await page.click('button[data-mode="translate"]');
+  const pivot = await remora(page, 'pivot');
+  const centre = await page.evaluate((q) => window.remora.projectPoint(...q), pivot);
+  // Downwards: the manipulator stays in view for the rules after this one.
+  await drag(page, centre.x, centre.y - 75, 0, 6);
+  await ready(page);
+  const s2 = await c.json('status');
+  const frames = (await remora(page, 'marks')).drag.length - frames0;
+  const off = await pageVsServer(page);
+  check(frames > 0 && s2.nonlinear?.converged === true && off < 1e-6,
+        `a nonlinear drag: ${frames} frames answered, then relaxed until converged (${JSON.stringify(s2.nonlinear)}), ` +
+        `the page holding the server's positions (off by ${off})`);
+  await page.selectOption('#method', 'linear');
+  await ready(page);
+  const s3 = await c.json('status');
+  check(s3.region?.method === 'linear' && !s3.nonlinear && await pageVsServer(page) === 0,
+        'the method linear again: the page shows its positions');
+}
+
 /// While a job runs (a stroke after a move: the shape is baked into a new base) the progress shows
-/// "phase — NN %" and undo, redo and export are disabled.
+/// "phase — NN %" and undo, redo and export are disabled. The bake may start in a pause of the
+/// stroke and end before mouse-up, so the page is watched from the stroke's start.
 async function busyButtons(page, site) {
   await page.keyboard.press('s');
   await remora(page, 'setRadius', 1.4 * site.supportRadius);
+  await page.evaluate(() => {
+    const seen = (window.__busySeen = []);
+    const look = () => {
+      if (document.getElementById('progress').hidden) return;
+      seen.push({
+        text: document.getElementById('progress-text').textContent,
+        disabled: ['#undo', '#redo', '#export button, #panel a.button']
+          .map((q) => [...document.querySelectorAll(q)].every((b) => b.disabled)),
+      });
+    };
+    window.__busyObserver = new MutationObserver(look);
+    window.__busyObserver.observe(document.getElementById('panel'), { attributes: true, childList: true, subtree: true, characterData: true });
+  });
   await stroke(page, site.supportVertex);
-  await page.waitForFunction(() => !document.getElementById('progress').hidden || window.remora.ready(),
-                             null, { timeout: 60000, polling: 20 });
-  const during = await page.evaluate(() => ({
-    progress: document.getElementById('progress').hidden ? null : document.getElementById('progress-text').textContent,
-    disabled: ['#undo', '#redo', '#export button, #panel a.button'].map((q) => [...document.querySelectorAll(q)].every((b) => b.disabled)),
-  }));
-  check(during.progress && /\d+ %/.test(during.progress) && during.disabled.every(Boolean),
-        `while a bake runs: "${during.progress}", undo, redo and export disabled (${during.disabled})`);
   await ready(page, 180000);
+  const seen = await page.evaluate(() => { window.__busyObserver.disconnect(); return window.__busySeen; });
+  const during = seen.find((x) => /\d+ %/.test(x.text)) ?? { text: null, disabled: [] };
+  const allDisabled = seen.filter((x) => /\d+ %/.test(x.text)).every((x) => x.disabled.every(Boolean));
+  check(during.text && allDisabled && during.disabled.length === 3,
+        `while a bake runs: "${during.text}", undo, redo and export disabled (${during.disabled}; ${seen.length} views of the progress)`);
   await page.keyboard.press('o');
 }
 
@@ -183,6 +247,60 @@ async function manipulatorRules(page, log) {
         `after New handle the manipulator is hidden (${shown}) and its old place sends no move (${sent}; "${box.hidden ? '' : box.text}")`);
 }
 
+/// The region's work hides behind the brush: a stroke that pauses sends the region painted so
+/// far; painting on after it sends the region again (the server stops the stale job) and the
+/// server ends with the region as painted at mouse-up; a pause with nothing painted after it
+/// leaves nothing to send at mouse-up.
+async function regionInPause(page, log, c, site) {
+  await page.keyboard.press('s');
+  await remora(page, 'setRadius', 0.8 * site.supportRadius);
+  // Start on the unpainted vertex nearest the support's centre, so that the stroke changes the
+  // region whatever earlier strokes painted.
+  const startVertex = await page.evaluate((c) => {
+    const p = window.remora.positionsHeld(), labels = window.remora.labels();
+    let best = -1, bestD = Infinity;
+    for (let v = 0; v < labels.length; ++v) {
+      if (labels[v] !== -2) continue;
+      const d = (p[3 * v] - c[0]) ** 2 + (p[3 * v + 1] - c[1]) ** 2 + (p[3 * v + 2] - c[2]) ** 2;
+      if (d < bestD) { bestD = d; best = v; }
+    }
+    return best;
+  }, site.support);
+  const start = await remora(page, 'project', startVertex);
+  // A stroke with a pause in the middle, then more paint elsewhere.
+  let from = log.length;
+  await page.mouse.move(start.x, start.y);
+  await page.mouse.down();
+  for (let i = 1; i <= 4; ++i) await page.mouse.move(start.x + 2 * i, start.y);
+  await page.waitForTimeout(900);
+  const inPause = since(log, from, /POST region/).length;
+  for (let i = 1; i <= 6; ++i) await page.mouse.move(start.x + 8, start.y + 4 * i);
+  await page.mouse.up();
+  await ready(page, 120000);
+  const sent = since(log, from, /POST region/);
+  const labels = await remora(page, 'labels');
+  const region = await c.json('region');
+  const painted = labels.flatMap((l, v) => (l !== -2 ? [v] : []));
+  check(inPause >= 1 && sent.length >= 2 && JSON.stringify(region?.support) === JSON.stringify(painted),
+        `a stroke's pause sends the region (${inPause} during it, ${sent.length} in all) and the server ` +
+        `ends with the region painted at mouse-up (${region?.support.length} = ${painted.length} vertices)`);
+  // A pause, then mouse-up without more paint: nothing left to send, the manipulator comes.
+  await page.keyboard.press('s');
+  from = log.length;
+  await page.mouse.move(start.x - 6, start.y - 6);
+  await page.mouse.down();
+  for (let i = 1; i <= 3; ++i) await page.mouse.move(start.x - 6 - 2 * i, start.y - 6);
+  await page.waitForTimeout(900);
+  await ready(page, 120000).catch(() => {});
+  const before = since(log, from, /POST region/).length;
+  await page.mouse.up();
+  await ready(page, 120000);
+  const after = since(log, from, /POST region/).length;
+  check(before >= 1 && after === before && await activeTool(page) === 'orbit' &&
+        (await remora(page, 'shown')).manipulator,
+        `a pause then mouse-up sends nothing more (${before} then ${after}) and shows the manipulator`);
+}
+
 export const bugChecks = {
   async beforeRegion(page, log, c, site) {
     await handleWithoutSupport(page, log, site);
@@ -194,10 +312,12 @@ export const bugChecks = {
     check(box && box.y >= 0 && box.y + box.height <= 800 && /set_region/.test(text),
           `at 1200x800 the stats, set_region line included, are in view (${box?.y.toFixed(0)}..${(box?.y + box?.height).toFixed(0)})`);
     await kAfterMove(page, c, edit);
+    await methodAfterMove(page, c, edit);
     await busyButtons(page, site);
     await scaleClamp(page, log);
     await exportName(page);
     await manipulatorRules(page, log);
+    await regionInPause(page, log, c, site);
   },
 };
 

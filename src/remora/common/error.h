@@ -29,6 +29,12 @@ public:
   using Error::Error;
 };
 
+/// The caller asked a long call to stop (a std::stop_token was triggered); nothing was changed.
+class Cancelled : public Error {
+public:
+  using Error::Error;
+};
+
 /// A file could not be read or written, or its content is malformed. what() reads
 /// "<path>: line <n>: <problem>" or "<path>: byte <offset>: <problem>" when the place is known.
 class IoError : public Error {

@@ -20,4 +20,14 @@ void parallel_for(std::size_t n, int threads, Body&& body) {
   for (long i = 0; i < count; ++i) body(static_cast<std::size_t>(i));
 }
 
+/// Runs body(b) for b in [0, n) on `threads` threads (0 = all), one index at a time as threads
+/// become free, however small n is: for loops over a few large blocks of work.
+template <class Body>
+void parallel_blocks(std::size_t n, int threads, Body&& body) {
+  const long count = static_cast<long>(n);
+  const int team = threads > 0 ? threads : omp_get_max_threads();
+#pragma omp parallel for schedule(dynamic, 1) num_threads(team) if (team > 1 && n > 1)
+  for (long i = 0; i < count; ++i) body(static_cast<std::size_t>(i));
+}
+
 } // namespace remora

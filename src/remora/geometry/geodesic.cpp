@@ -17,11 +17,11 @@ namespace {
 constexpr double kInf = std::numeric_limits<double>::infinity();
 constexpr std::uint8_t kFar = 0, kTrial = 1, kAccepted = 2;
 
-/// The distance at c of triangle (a, b, c) from the distances da at a and db at b: the triangle
-/// unfolded into the plane, a virtual source on the far side of ab at distances da and db, and the
-/// straight line from it to c if that line crosses ab; otherwise the shorter edge path.
-double through_triangle(const Vec3& a, const Vec3& b, const Vec3& c, double da, double db) {
-  const double ab = (b - a).norm(), ac = (c - a).norm(), bc = (c - b).norm();
+/// The distance at c of triangle (a, b, c), given by its edge lengths ab, ac, bc, from the
+/// distances da at a and db at b: the triangle unfolded into the plane, a virtual source on the
+/// far side of ab at distances da and db, and the straight line from it to c if that line crosses
+/// ab; otherwise the shorter edge path.
+double through_triangle(double ab, double ac, double bc, double da, double db) {
   const double edge_path = std::min(da + ac, db + bc);
   if (!(ab > 0.0)) return edge_path;
   // a at the origin, b on the positive x axis, c above it.
@@ -36,7 +36,8 @@ double through_triangle(const Vec3& a, const Vec3& b, const Vec3& c, double da, 
   const double t = -sy / (cy - sy); // where the line from s to c meets the x axis
   const double x = sx + t * (cx - sx);
   if (x < 0.0 || x > ab) return edge_path;
-  return std::min(edge_path, std::hypot(cx - sx, cy - sy));
+  const double dx = cx - sx, dy = cy - sy; // magnitudes of the mesh's size: no overflow
+  return std::min(edge_path, std::sqrt(dx * dx + dy * dy));
 }
 
 void check_radius(double radius) {
@@ -103,10 +104,12 @@ FastMarching::march(const Mesh& mesh, const std::vector<std::pair<int, double>>&
         const auto x = static_cast<std::size_t>(ring_[r][static_cast<std::size_t>(side)]);
         const auto y = static_cast<std::size_t>(ring_[r][static_cast<std::size_t>(1 - side)]);
         if (state_[y] == kAccepted) continue;
-        double candidate = d + (points[y] - pv).norm();
+        const double vy = (points[y] - pv).norm();
+        double candidate = d + vy;
         if (state_[x] == kAccepted)
-          candidate =
-              std::min(candidate, through_triangle(pv, points[x], points[y], d, distance_[x]));
+          candidate = std::min(candidate,
+                               through_triangle((points[x] - pv).norm(), vy,
+                                                (points[y] - points[x]).norm(), d, distance_[x]));
         offer(static_cast<int>(y), candidate);
       }
   }

@@ -18,36 +18,65 @@ namespace {
 // which a face counts as zero-area: its cotangents would be rounding noise of size up to 1e16.
 constexpr double kDegenerate = 1e-12;
 
-/// W_ij for every edge, indexed by edge idx() (0 for deleted edges).
-std::vector<double> edge_weights(const Mesh& mesh) {
-  std::vector<double> weights(mesh.n_edges(), 0.0);
-  for (const FaceHandle f : mesh.faces()) {
-    const HalfedgeHandle h0 = mesh.halfedge_handle(f);
-    const HalfedgeHandle h1 = mesh.next_halfedge_handle(h0);
-    const HalfedgeHandle h2 = mesh.next_halfedge_handle(h1);
-    // Corner k sits opposite halfedge opposite[k].
-    const std::array<HalfedgeHandle, 3> opposite{h1, h2, h0};
-    const std::array<Vec3, 3> p{mesh.point(mesh.from_vertex_handle(h0)),
-                                mesh.point(mesh.to_vertex_handle(h0)),
-                                mesh.point(mesh.to_vertex_handle(h1))};
-    // e[k] is the edge opposite corner k.
-    const std::array<Vec3, 3> e{p[2] - p[1], p[0] - p[2], p[1] - p[0]};
-    const std::array<double, 3> l{e[0].sqrnorm(), e[1].sqrnorm(), e[2].sqrnorm()};
-    // The doubled area from the two shortest edges (the most accurate pair).
-    const std::size_t longest =
-        l[0] >= l[1] && l[0] >= l[2] ? 0 : (l[1] >= l[2] ? std::size_t{1} : std::size_t{2});
-    const double twice_area = (e[(longest + 1) % 3] % e[(longest + 2) % 3]).norm();
+/// Half the cotangent of each corner of face f, with the edge opposite it: {weight, edge idx()}
+/// per corner; weight 0 for a zero-area face.
+std::array<std::pair<double, int>, 3> half_cotangents(const Mesh& mesh, FaceHandle f) {
+  const HalfedgeHandle h0 = mesh.halfedge_handle(f);
+  const HalfedgeHandle h1 = mesh.next_halfedge_handle(h0);
+  const HalfedgeHandle h2 = mesh.next_halfedge_handle(h1);
+  // Corner k sits opposite halfedge opposite[k].
+  const std::array<HalfedgeHandle, 3> opposite{h1, h2, h0};
+  const std::array<Vec3, 3> p{mesh.point(mesh.from_vertex_handle(h0)),
+                              mesh.point(mesh.to_vertex_handle(h0)),
+                              mesh.point(mesh.to_vertex_handle(h1))};
+  // e[k] is the edge opposite corner k.
+  const std::array<Vec3, 3> e{p[2] - p[1], p[0] - p[2], p[1] - p[0]};
+  const std::array<double, 3> l{e[0].sqrnorm(), e[1].sqrnorm(), e[2].sqrnorm()};
+  // The doubled area from the two shortest edges (the most accurate pair).
+  const std::size_t longest =
+      l[0] >= l[1] && l[0] >= l[2] ? 0 : (l[1] >= l[2] ? std::size_t{1} : std::size_t{2});
+  const double twice_area = (e[(longest + 1) % 3] % e[(longest + 2) % 3]).norm();
+  std::array<std::pair<double, int>, 3> out;
+  for (std::size_t k = 0; k < 3; ++k) {
+    out[k] = {0.0, mesh.edge_handle(opposite[k]).idx()};
     if (!(twice_area > kDegenerate * l[longest])) continue;
-    for (std::size_t k = 0; k < 3; ++k) {
-      // The corner's edge vectors are -e[k+1] and e[k+2]; cot = their dot / |their cross|.
-      const double cot = -(e[(k + 1) % 3] | e[(k + 2) % 3]) / twice_area;
-      weights[mesh.edge_handle(opposite[k]).idx()] += 0.5 * cot;
-    }
+    // The corner's edge vectors are -e[k+1] and e[k+2]; cot = their dot / |their cross|.
+    out[k].first = 0.5 * (-(e[(k + 1) % 3] | e[(k + 2) % 3]) / twice_area);
   }
+  return out;
+}
+
+/// W_ij for every edge, indexed by edge idx() (0 for deleted edges). The faces' cotangents are
+/// computed in parallel and added in face order: the same sums as one sequential loop.
+std::vector<double> edge_weights(const Mesh& mesh) {
+  const auto halves = per_face<std::array<std::pair<double, int>, 3>>(
+      mesh, [&](FaceHandle f) { return half_cotangents(mesh, f); });
+  std::vector<double> weights(mesh.n_edges(), 0.0);
+  for (const FaceHandle f : mesh.faces())
+    for (const auto& [w, e] : halves[static_cast<std::size_t>(f.idx())])
+      weights[static_cast<std::size_t>(e)] += w;
   return weights;
 }
 
 } // namespace
+
+std::vector<double> cotan_edge_weights(const Mesh& mesh) {
+  return edge_weights(mesh);
+}
+
+double cotan_weight(const Mesh& mesh, EdgeHandle e) {
+  // In face order, as edge_weights() adds them.
+  FaceHandle faces[2] = {mesh.face_handle(mesh.halfedge_handle(e, 0)),
+                         mesh.face_handle(mesh.halfedge_handle(e, 1))};
+  if (faces[0].idx() > faces[1].idx()) std::swap(faces[0], faces[1]);
+  double w = 0.0;
+  for (const FaceHandle f : faces) {
+    if (!f.is_valid()) continue;
+    for (const auto& [half, edge] : half_cotangents(mesh, f))
+      if (edge == e.idx()) w += half;
+  }
+  return w;
+}
 
 Eigen::SparseMatrix<double> weights_matrix(const Mesh& mesh, const std::vector<double>& weights) {
   if (weights.size() != mesh.n_edges())

@@ -30,6 +30,13 @@ namespace remora {
 /// whose magnitude that threshold bounds by 1e12. No entry is NaN or Inf. W 1 = 0 to round-off.
 Eigen::SparseMatrix<double> cotan_weights(const Mesh& mesh);
 
+/// W_ij of the one edge e = (i, j), the same value as cotan_weights()'s entry.
+double cotan_weight(const Mesh& mesh, EdgeHandle e);
+
+/// W_ij of every edge, by edge idx() (0 for deleted edges): cotan_weights()'s off-diagonal
+/// entries without the matrix.
+std::vector<double> cotan_edge_weights(const Mesh& mesh);
+
 /// The symmetric n_vertices() x n_vertices() matrix of any edge weights, assembled like W above:
 /// W_ij = W_ji = weights[e.idx()] for every live edge e = (i, j), W_ii = -sum_j W_ij, with
 /// cotan_weights()'s structure (two edges joining the same vertices are summed). Throws

@@ -45,13 +45,16 @@ AngleFigures angle_figures(const Mesh& mesh) {
   std::size_t above_90 = 0;
   std::size_t above_150 = 0;
   std::size_t faces_min_below_10 = 0;
-  for (const FaceHandle f : mesh.faces()) {
+  const auto face_angles = per_face<std::array<double, 3>>(mesh, [&](FaceHandle f) {
     auto v = mesh.cfv_iter(f);
     const Vec3& a = mesh.point(*v);
     const Vec3& b = mesh.point(*++v);
     const Vec3& c = mesh.point(*++v);
+    return triangle_angles(a, b, c);
+  });
+  for (const FaceHandle f : mesh.faces()) {
     double face_min = std::numeric_limits<double>::infinity();
-    for (const double theta : triangle_angles(a, b, c)) {
+    for (const double theta : face_angles[static_cast<std::size_t>(f.idx())]) {
       const double deg = degrees(theta);
       min_deg = std::min(min_deg, deg);
       max_deg = std::max(max_deg, deg);
@@ -80,9 +83,12 @@ AngleFigures angle_figures(const Mesh& mesh) {
 
 EdgeLengthFigures edge_length_figures(const Mesh& mesh) {
   EdgeLengthFigures figures;
-  std::vector<double> lengths;
-  lengths.reserve(mesh.n_edges());
-  for (const EdgeHandle e : mesh.edges()) lengths.push_back(mesh.calc_edge_length(e));
+  std::vector<double> lengths(mesh.n_edges(), -1.0);
+  parallel_for(lengths.size(), 0, [&](std::size_t i) {
+    const EdgeHandle e(static_cast<int>(i));
+    if (!mesh.status(e).deleted()) lengths[i] = mesh.calc_edge_length(e);
+  });
+  lengths.erase(std::remove(lengths.begin(), lengths.end(), -1.0), lengths.end());
   if (lengths.empty()) return figures;
   const auto [min_it, max_it] = std::minmax_element(lengths.begin(), lengths.end());
   figures.min = *min_it;
@@ -96,6 +102,8 @@ EdgeLengthFigures edge_length_figures(const Mesh& mesh) {
   figures.cv = figures.mean > 0.0 ? std::sqrt(squares / n) / figures.mean : 0.0;
   return figures;
 }
+
+} // namespace
 
 VertexAreaFigures vertex_area_figures(const Eigen::VectorXd& areas,
                                       const std::vector<VertexHandle>& interior) {
@@ -117,6 +125,8 @@ VertexAreaFigures vertex_area_figures(const Eigen::VectorXd& areas,
   figures.rel_mad = absolute / n / figures.mean;
   return figures;
 }
+
+namespace {
 
 nlohmann::json histogram_json(const std::map<int, std::size_t>& histogram) {
   nlohmann::json array = nlohmann::json::array();
@@ -146,19 +156,7 @@ double percent_edges_within(const Mesh& mesh, double lo, double hi) {
   return edges > 0 ? 100.0 * static_cast<double>(within) / static_cast<double>(edges) : 0.0;
 }
 
-MeshQuality mesh_quality(const Mesh& mesh) {
-  MeshQuality q;
-
-  // Counts and topology.
-  q.vertices = count(mesh.vertices());
-  q.faces = count(mesh.faces());
-  q.edges = count(mesh.edges());
-  q.boundary_loops = boundary_loops(mesh).size();
-  q.component_topology = component_topology(mesh);
-  q.components = q.component_topology.size();
-
-  // Vertex classes and valences.
-  std::vector<VertexHandle> interior;
+void vertex_figures(const Mesh& mesh, MeshQuality& q, std::vector<VertexHandle>& interior) {
   std::size_t interior_6 = 0;
   std::size_t boundary_4 = 0;
   for (const VertexHandle v : mesh.vertices()) {
@@ -180,7 +178,23 @@ MeshQuality mesh_quality(const Mesh& mesh) {
   q.interior_vertices = interior.size();
   q.valence.percent_interior_6 = percent(interior_6, q.interior_vertices);
   q.valence.percent_boundary_4 = percent(boundary_4, q.boundary_vertices);
+}
 
+MeshQuality mesh_quality(const Mesh& mesh, const QualityOptions& options) {
+  MeshQuality q;
+
+  // Counts and topology.
+  q.vertices = count(mesh.vertices());
+  q.faces = count(mesh.faces());
+  q.edges = count(mesh.edges());
+  if (options.topology) {
+    q.boundary_loops = boundary_loops(mesh).size();
+    q.component_topology = component_topology(mesh);
+    q.components = q.component_topology.size();
+  }
+
+  std::vector<VertexHandle> interior;
+  vertex_figures(mesh, q, interior);
   q.angles = angle_figures(mesh);
   q.edge_length = edge_length_figures(mesh);
   q.barycentric_area = vertex_area_figures(vertex_areas_barycentric(mesh), interior);
@@ -188,9 +202,11 @@ MeshQuality mesh_quality(const Mesh& mesh) {
 
   q.bounding_box = bounding_box(mesh);
   q.bounding_box_diagonal = q.bounding_box.diagonal();
-  for (const FaceHandle f : mesh.faces()) {
-    q.zero_area_faces += is_zero_area(face_area(mesh, f), q.bounding_box_diagonal) ? 1 : 0;
-  }
+  const std::vector<double> areas =
+      per_face<double>(mesh, [&](FaceHandle f) { return face_area(mesh, f); });
+  for (const FaceHandle f : mesh.faces())
+    q.zero_area_faces +=
+        is_zero_area(areas[static_cast<std::size_t>(f.idx())], q.bounding_box_diagonal) ? 1 : 0;
   return q;
 }
 

@@ -79,7 +79,22 @@ struct MeshQuality {
   double bounding_box_diagonal = 0.0;
 };
 
-MeshQuality mesh_quality(const Mesh& mesh);
+struct QualityOptions {
+  /// The topological figures (boundary_loops, components, component_topology); off, they stay
+  /// 0 and empty (a caller that knows them from elsewhere saves their cost).
+  bool topology = true;
+};
+
+/// Every figure above. The per-face and per-edge values are computed on all hardware threads and
+/// added up in element order: the figures do not depend on the number of threads.
+MeshQuality mesh_quality(const Mesh& mesh, const QualityOptions& options = {});
+
+/// mesh_quality()'s vertex counts and valences into `q`; `interior` gets the interior vertices.
+void vertex_figures(const Mesh& mesh, MeshQuality& q, std::vector<VertexHandle>& interior);
+
+/// mesh_quality()'s figures of per-vertex `areas` over the vertices `interior`.
+VertexAreaFigures vertex_area_figures(const Eigen::VectorXd& areas,
+                                      const std::vector<VertexHandle>& interior);
 
 /// Percentage of the (live) edges whose length lies in [lo, hi]: the remesher's band is
 /// [4/5 l, 4/3 l] (§4). 0 for a mesh without edges.

@@ -4,6 +4,7 @@
 #include <string>
 
 #include "remora/common/error.h"
+#include "remora/common/parallel.h"
 #include "remora/geometry/laplacian.h"
 #include "remora/geometry/measures.h"
 #include "remora/mesh/topology.h"
@@ -13,13 +14,11 @@ namespace remora {
 namespace {
 
 using RowMatrix = Eigen::SparseMatrix<double, Eigen::RowMajor>;
-using Triplet = Eigen::Triplet<double>;
 
-void validate(const Mesh& mesh, const Region& region, const KHarmonicOptions& options) {
+void validate_labels(std::size_t n, const Region& region, const KHarmonicOptions& options) {
   if (options.k < 1 || options.k > 3)
     throw InvalidArgument("k-harmonic system: k = " + std::to_string(options.k) +
                           " is not supported; use 1, 2 or 3");
-  const std::size_t n = mesh.n_vertices();
   if (region.label.size() != n)
     throw InvalidArgument("k-harmonic system: the region has " +
                           std::to_string(region.label.size()) + " labels for a mesh of " +
@@ -31,72 +30,13 @@ void validate(const Mesh& mesh, const Region& region, const KHarmonicOptions& op
                             "; use -1 (free), -2 (fixed) or a handle index >= 0");
   if (region.free_count() == 0)
     throw InvalidArgument("k-harmonic system: no vertex is free; the support is empty");
-
-  // Every handle has a vertex and touches a free vertex.
-  const int handles = region.handle_count();
-  std::vector<char> has_vertex(static_cast<std::size_t>(handles), 0),
-      touches_free(static_cast<std::size_t>(handles), 0);
-  for (auto v : mesh.vertices()) {
-    const int j = region.label[static_cast<std::size_t>(v.idx())];
-    if (j < 0) continue;
-    has_vertex[static_cast<std::size_t>(j)] = 1;
-    for (auto w : mesh.vv_range(v))
-      if (region.label[static_cast<std::size_t>(w.idx())] == Region::kFree)
-        touches_free[static_cast<std::size_t>(j)] = 1;
-  }
-  for (int j = 0; j < handles; ++j) {
-    if (!has_vertex[static_cast<std::size_t>(j)])
-      throw InvalidArgument("k-harmonic system: handle " + std::to_string(j) +
-                            " has no vertex (handles are numbered 0.." +
-                            std::to_string(handles - 1) + " without gaps)");
-    if (!touches_free[static_cast<std::size_t>(j)])
-      throw InvalidArgument("k-harmonic system: handle " + std::to_string(j) +
-                            " touches no free vertex, so moving it would move nothing; put it "
-                            "inside or next to the support");
-  }
-
-  // Every component with a free vertex has a constrained one.
-  const Components components = connected_components(mesh);
-  std::vector<int> free_witness(static_cast<std::size_t>(components.count), -1);
-  std::vector<char> constrained(static_cast<std::size_t>(components.count), 0);
-  for (auto v : mesh.vertices()) {
-    const int c = components.vertex_component[static_cast<std::size_t>(v.idx())];
-    if (c < 0) continue;
-    if (region.label[static_cast<std::size_t>(v.idx())] == Region::kFree) {
-      if (free_witness[static_cast<std::size_t>(c)] < 0)
-        free_witness[static_cast<std::size_t>(c)] = v.idx();
-    } else {
-      constrained[static_cast<std::size_t>(c)] = 1;
-    }
-  }
-  for (int c = 0; c < components.count; ++c)
-    if (free_witness[static_cast<std::size_t>(c)] >= 0 && !constrained[static_cast<std::size_t>(c)])
-      throw InvalidArgument(
-          "k-harmonic system: the support covers a whole connected component of the mesh (the "
-          "one with vertex " +
-          std::to_string(free_witness[static_cast<std::size_t>(c)]) +
-          ") with no fixed or handle vertex, so its position is undetermined; fix at least one "
-          "vertex of that component or make the support smaller");
-}
-
-// Numbers the free vertices in vertex order: system.free_vertices and system.row_of (-1 for a
-// vertex that is not free), over the region's n labels.
-void number_free_vertices(const Region& region, KHarmonicSystem& system) {
-  const auto n = static_cast<Eigen::Index>(region.label.size());
-  system.row_of.assign(static_cast<std::size_t>(n), -1);
-  for (Eigen::Index v = 0; v < n; ++v)
-    if (region.label[static_cast<std::size_t>(v)] == Region::kFree) {
-      system.row_of[static_cast<std::size_t>(v)] = static_cast<int>(system.free_vertices.size());
-      system.free_vertices.push_back(static_cast<int>(v));
-    }
 }
 
 // The inverse vertex areas of the inner factors: 1 / mixed area, floored at 1e-12 times the mean
-// positive area; all 1 for Mean (the Ā^k factor drops out of the rows).
-Eigen::VectorXd inverse_areas(const Mesh& mesh, AreaWeights areas) {
+// positive area. A vertex whose faces all have zero area (needles of a raw scan) gets a floor
+// instead of an infinite inverse; its row of W is zero anyway.
+Eigen::VectorXd inverse_mixed_areas(const Mesh& mesh) {
   const auto n = static_cast<Eigen::Index>(mesh.n_vertices());
-  Eigen::VectorXd inverse_area = Eigen::VectorXd::Ones(n);
-  if (areas == AreaWeights::Mean) return inverse_area;
   const Eigen::VectorXd area = vertex_areas_mixed(mesh);
   double mean = 0;
   Eigen::Index counted = 0;
@@ -106,75 +46,198 @@ Eigen::VectorXd inverse_areas(const Mesh& mesh, AreaWeights areas) {
       ++counted;
     }
   mean = counted > 0 ? mean / static_cast<double>(counted) : 1.0;
-  // A vertex whose faces all have zero area (needles of a raw scan) gets a floor instead of
-  // an infinite inverse; its row of W is zero anyway.
+  Eigen::VectorXd inverse_area(n);
   for (Eigen::Index v = 0; v < n; ++v) inverse_area[v] = 1.0 / std::max(area[v], 1e-12 * mean);
   return inverse_area;
 }
 
-// Rows `free_vertices` of −W, in that order (free × all vertices).
-RowMatrix free_rows(const SparseMatrix& minus_w, const std::vector<int>& free_vertices) {
-  const auto nf = static_cast<Eigen::Index>(free_vertices.size());
-  RowMatrix rows(nf, minus_w.cols());
-  std::vector<Triplet> triplets;
-  triplets.reserve(static_cast<std::size_t>(nf) * 7);
-  for (Eigen::Index r = 0; r < nf; ++r) {
-    const int v = free_vertices[static_cast<std::size_t>(r)];
-    for (SparseMatrix::InnerIterator it(minus_w, v); it; ++it) // W is symmetric: column = row
-      triplets.emplace_back(r, it.row(), it.value());
-  }
-  rows.setFromTriplets(triplets.begin(), triplets.end());
-  return rows;
-}
-
-// The free vertices' rows of the k-th power: R = rows F of (−W), then R ← R · A⁻¹(−W) for each
-// further power; for Mixed areas each row is then scaled by its vertex's inverse area.
-RowMatrix power_rows(const SparseMatrix& minus_w, const Eigen::VectorXd& inverse_area,
-                     const std::vector<int>& free_vertices, const KHarmonicOptions& options) {
-  RowMatrix rows = free_rows(minus_w, free_vertices);
-  if (options.k > 1) {
-    const SparseMatrix step = inverse_area.asDiagonal() * minus_w;
-    for (int power = 1; power < options.k; ++power) rows = RowMatrix(rows * step);
-  }
-  if (options.areas == AreaWeights::Mixed)
-    for (Eigen::Index r = 0; r < rows.rows(); ++r)
-      rows.row(r) *= inverse_area[free_vertices[static_cast<std::size_t>(r)]];
-  return rows;
-}
-
-// Splits the non-zero entries of `rows` by column: the free vertices' into system.matrix (by
-// row_of), the constrained vertices' into system.coupling (numbered in vertex order into
-// system.constrained_vertices).
-void split_columns(const RowMatrix& rows, KHarmonicSystem& system) {
-  const Eigen::Index nf = rows.rows();
-  std::vector<int> column_of(static_cast<std::size_t>(rows.cols()), -1);
-  std::vector<Triplet> free_part, constrained_part;
-  free_part.reserve(static_cast<std::size_t>(rows.nonZeros()));
-  for (Eigen::Index r = 0; r < nf; ++r)
-    for (RowMatrix::InnerIterator it(rows, r); it; ++it) {
-      if (it.value() == 0.0) continue;
-      const auto v = static_cast<std::size_t>(it.col());
-      if (system.row_of[v] >= 0) {
-        free_part.emplace_back(r, system.row_of[v], it.value());
-      } else {
-        if (column_of[v] < 0) column_of[v] = 0; // numbered below, in vertex order
-        constrained_part.emplace_back(r, static_cast<Eigen::Index>(v), it.value());
-      }
+// Numbers the free vertices in vertex order: system.free_vertices and system.row_of (-1 for a
+// vertex that is not free).
+void number_free_vertices(const Region& region, KHarmonicSystem& system) {
+  const std::size_t n = region.label.size();
+  system.row_of.assign(n, -1);
+  for (std::size_t v = 0; v < n; ++v)
+    if (region.label[v] == Region::kFree) {
+      system.row_of[v] = static_cast<int>(system.free_vertices.size());
+      system.free_vertices.push_back(static_cast<int>(v));
     }
-  for (std::size_t v = 0; v < column_of.size(); ++v)
+}
+
+// A row of a sparse product being accumulated: values by vertex, and the vertices touched.
+struct Accumulator {
+  explicit Accumulator(std::size_t n) : value(n), seen(n, 0) {}
+  std::vector<double> value;
+  std::vector<char> seen;
+  std::vector<int> touched;
+  void add(int j, double x) {
+    const auto u = static_cast<std::size_t>(j);
+    if (!seen[u]) {
+      seen[u] = 1;
+      value[u] = 0.0;
+      touched.push_back(j);
+    }
+    value[u] += x;
+  }
+  void clear() {
+    for (const int j : touched) seen[static_cast<std::size_t>(j)] = 0;
+    touched.clear();
+  }
+};
+
+// Row v of (−W)(S(−W))^(k−1), S = diag(scale) (null: the identity), accumulated into `out`. Each
+// term is (a_vm a_mj) s_m, summed in increasing m, so that for k <= 2 the entries (v, j) and
+// (j, v) are the same sums of the same products: symmetric bit for bit.
+void power_row(const SparseMatrix& minus_w, const Eigen::VectorXd* scale, int k, int v,
+               Accumulator& inner, Accumulator& out) {
+  const auto column = [&](int c, auto&& f) {
+    for (SparseMatrix::InnerIterator it(minus_w, c); it; ++it)
+      f(static_cast<int>(it.row()), it.value());
+  };
+  const auto s = [&](int m) { return scale ? (*scale)[m] : 1.0; };
+  if (k == 1) {
+    column(v, [&](int j, double a) { out.add(j, a); });
+    return;
+  }
+  Accumulator& second = k == 2 ? out : inner;
+  column(v, [&](int m, double a) {
+    const double sm = s(m);
+    column(m, [&](int j, double b) { second.add(j, a * b * sm); });
+  });
+  if (k == 2) return;
+  std::sort(inner.touched.begin(), inner.touched.end());
+  for (const int m : inner.touched) {
+    const double r = inner.value[static_cast<std::size_t>(m)], sm = s(m);
+    column(m, [&](int j, double b) { out.add(j, r * b * sm); });
+  }
+  inner.clear();
+}
+
+// The free rows of one block, as (vertex, value) lists in vertex order without the zero sums;
+// `mixed_scale` scales each row by its vertex's inverse area (the Mixed system).
+struct RowBlock {
+  std::vector<int> start{0}, vertex;
+  std::vector<double> value;
+};
+
+RowBlock power_rows(const SparseMatrix& minus_w, const Eigen::VectorXd* scale, int k,
+                    const Eigen::VectorXd* mixed_scale, const std::vector<int>& free_vertices,
+                    std::size_t begin, std::size_t end) {
+  const auto n = static_cast<std::size_t>(minus_w.rows());
+  Accumulator inner(k == 3 ? n : 0), out(n);
+  RowBlock block;
+  for (std::size_t r = begin; r < end; ++r) {
+    const int v = free_vertices[r];
+    power_row(minus_w, scale, k, v, inner, out);
+    std::sort(out.touched.begin(), out.touched.end());
+    const double row_scale = mixed_scale ? (*mixed_scale)[v] : 1.0;
+    for (const int j : out.touched) {
+      const double x = out.value[static_cast<std::size_t>(j)];
+      if (x == 0.0) continue;
+      block.vertex.push_back(j);
+      block.value.push_back(mixed_scale ? x * row_scale : x);
+    }
+    out.clear();
+    block.start.push_back(static_cast<int>(block.vertex.size()));
+  }
+  return block;
+}
+
+// Splits the rows by column into system.matrix (free columns, by row_of) and system.coupling
+// (constrained columns, numbered in vertex order into system.constrained_vertices).
+void split_columns(const std::vector<RowBlock>& blocks, std::size_t n, KHarmonicSystem& system) {
+  std::vector<int> column_of(n, -1);
+  for (const RowBlock& b : blocks)
+    for (const int j : b.vertex)
+      if (system.row_of[static_cast<std::size_t>(j)] < 0)
+        column_of[static_cast<std::size_t>(j)] = 0;
+  for (std::size_t v = 0; v < n; ++v)
     if (column_of[v] >= 0) {
       column_of[v] = static_cast<int>(system.constrained_vertices.size());
       system.constrained_vertices.push_back(static_cast<int>(v));
     }
-  for (Triplet& t : constrained_part)
-    t = Triplet(t.row(), column_of[static_cast<std::size_t>(t.col())], t.value());
-  system.matrix.resize(nf, nf);
-  system.matrix.setFromTriplets(free_part.begin(), free_part.end());
-  system.coupling.resize(nf, static_cast<Eigen::Index>(system.constrained_vertices.size()));
-  system.coupling.setFromTriplets(constrained_part.begin(), constrained_part.end());
+  const auto nf = static_cast<Eigen::Index>(system.free_vertices.size());
+  const auto nc = static_cast<Eigen::Index>(system.constrained_vertices.size());
+  // Both numberings follow the vertex order, so each row's entries come out sorted.
+  std::vector<int> free_start{0}, constrained_start{0}, free_column, constrained_column;
+  std::vector<double> free_value, constrained_value;
+  for (const RowBlock& b : blocks)
+    for (std::size_t r = 0; r + 1 < b.start.size(); ++r) {
+      for (auto e = static_cast<std::size_t>(b.start[r]);
+           e < static_cast<std::size_t>(b.start[r + 1]); ++e) {
+        const auto j = static_cast<std::size_t>(b.vertex[e]);
+        if (system.row_of[j] >= 0) {
+          free_column.push_back(system.row_of[j]);
+          free_value.push_back(b.value[e]);
+        } else {
+          constrained_column.push_back(column_of[j]);
+          constrained_value.push_back(b.value[e]);
+        }
+      }
+      free_start.push_back(static_cast<int>(free_column.size()));
+      constrained_start.push_back(static_cast<int>(constrained_column.size()));
+    }
+  // A symmetric matrix is its own transpose: its row-major arrays are its column-major ones.
+  if (system.symmetric) {
+    system.matrix =
+        Eigen::Map<const SparseMatrix>(nf, nf, static_cast<Eigen::Index>(free_value.size()),
+                                       free_start.data(), free_column.data(), free_value.data());
+  } else {
+    system.matrix =
+        Eigen::Map<const RowMatrix>(nf, nf, static_cast<Eigen::Index>(free_value.size()),
+                                    free_start.data(), free_column.data(), free_value.data());
+  }
+  const Eigen::Map<const RowMatrix> coupling(
+      nf, nc, static_cast<Eigen::Index>(constrained_value.size()), constrained_start.data(),
+      constrained_column.data(), constrained_value.data());
+  system.coupling = coupling;
 }
 
 } // namespace
+
+KHarmonicAssembler::KHarmonicAssembler(const Mesh& mesh, int threads)
+    : minus_w_(-cotan_weights(mesh)), inverse_area_(inverse_mixed_areas(mesh)), threads_(threads) {
+  minus_w_.makeCompressed();
+  const std::size_t n = mesh.n_vertices();
+  offsets_.assign(n + 1, 0);
+  for (const VertexHandle v : mesh.vertices()) {
+    for (const VertexHandle w : mesh.vv_range(v)) adjacent_.push_back(w.idx());
+    offsets_[static_cast<std::size_t>(v.idx()) + 1] = static_cast<int>(adjacent_.size());
+  }
+  for (std::size_t v = 0; v < n; ++v) offsets_[v + 1] = std::max(offsets_[v + 1], offsets_[v]);
+  const Components components = connected_components(mesh);
+  component_ = components.vertex_component;
+  components_ = components.count;
+}
+
+KHarmonicSystem KHarmonicAssembler::assemble(const Region& region,
+                                             const KHarmonicOptions& options) const {
+  const std::size_t n = vertex_count();
+  validate_labels(n, region, options);
+  check_handles_and_components(region);
+  KHarmonicSystem system;
+  system.symmetric = options.areas != AreaWeights::Mixed;
+  number_free_vertices(region, system);
+  const Eigen::VectorXd* scale = options.areas == AreaWeights::Mean ? nullptr : &inverse_area_;
+  const Eigen::VectorXd* mixed = options.areas == AreaWeights::Mixed ? &inverse_area_ : nullptr;
+  const std::size_t nf = system.free_vertices.size();
+  const int team = threads_ > 0 ? threads_ : omp_get_max_threads();
+  const std::size_t count = nf < 4096 ? 1 : static_cast<std::size_t>(4 * team);
+  std::vector<RowBlock> blocks(count);
+  parallel_blocks(count, threads_, [&](std::size_t b) {
+    blocks[b] = power_rows(minus_w_, scale, options.k, mixed, system.free_vertices, b * nf / count,
+                           (b + 1) * nf / count);
+  });
+  split_columns(blocks, n, system);
+  if (system.symmetric && options.k == 3) {
+    // k = 3 sums its products in another order for (i, j) than for (j, i): symmetric to
+    // round-off only.
+    const SparseMatrix transposed = system.matrix.transpose();
+    system.matrix = 0.5 * (system.matrix + transposed);
+  }
+  system.matrix.makeCompressed();
+  system.coupling.makeCompressed();
+  return system;
+}
 
 int Region::handle_count() const {
   int h = 0;
@@ -221,23 +284,57 @@ Eigen::MatrixXd KHarmonicSystem::gather_constrained(const Eigen::MatrixXd& posit
   return out;
 }
 
+// Every handle has a vertex and touches a free vertex; every component with a free vertex has a
+// constrained one.
+void KHarmonicAssembler::check_handles_and_components(const Region& region) const {
+  const std::size_t n = vertex_count();
+  const int handles = region.handle_count();
+  std::vector<char> has_vertex(static_cast<std::size_t>(handles), 0),
+      touches_free(static_cast<std::size_t>(handles), 0);
+  for (std::size_t v = 0; v < n; ++v) {
+    const int j = region.label[v];
+    if (j < 0 || component_[v] < 0) continue;
+    has_vertex[static_cast<std::size_t>(j)] = 1;
+    for (int e = offsets_[v]; e < offsets_[v + 1]; ++e)
+      if (region.label[static_cast<std::size_t>(adjacent_[static_cast<std::size_t>(e)])] ==
+          Region::kFree)
+        touches_free[static_cast<std::size_t>(j)] = 1;
+  }
+  for (int j = 0; j < handles; ++j) {
+    if (!has_vertex[static_cast<std::size_t>(j)])
+      throw InvalidArgument("k-harmonic system: handle " + std::to_string(j) +
+                            " has no vertex (handles are numbered 0.." +
+                            std::to_string(handles - 1) + " without gaps)");
+    if (!touches_free[static_cast<std::size_t>(j)])
+      throw InvalidArgument("k-harmonic system: handle " + std::to_string(j) +
+                            " touches no free vertex, so moving it would move nothing; put it "
+                            "inside or next to the support");
+  }
+  std::vector<int> free_witness(static_cast<std::size_t>(components_), -1);
+  std::vector<char> constrained(static_cast<std::size_t>(components_), 0);
+  for (std::size_t v = 0; v < n; ++v) {
+    const int c = component_[v];
+    if (c < 0) continue;
+    if (region.label[v] == Region::kFree) {
+      if (free_witness[static_cast<std::size_t>(c)] < 0)
+        free_witness[static_cast<std::size_t>(c)] = static_cast<int>(v);
+    } else {
+      constrained[static_cast<std::size_t>(c)] = 1;
+    }
+  }
+  for (int c = 0; c < components_; ++c)
+    if (free_witness[static_cast<std::size_t>(c)] >= 0 && !constrained[static_cast<std::size_t>(c)])
+      throw InvalidArgument(
+          "k-harmonic system: the support covers a whole connected component of the mesh (the "
+          "one with vertex " +
+          std::to_string(free_witness[static_cast<std::size_t>(c)]) +
+          ") with no fixed or handle vertex, so its position is undetermined; fix at least one "
+          "vertex of that component or make the support smaller");
+}
+
 KHarmonicSystem assemble_kharmonic(const Mesh& mesh, const Region& region,
                                    const KHarmonicOptions& options) {
-  validate(mesh, region, options);
-  KHarmonicSystem system;
-  system.symmetric = options.areas != AreaWeights::Mixed;
-  number_free_vertices(region, system);
-  const SparseMatrix minus_w = -cotan_weights(mesh);
-  const Eigen::VectorXd inverse_area = inverse_areas(mesh, options.areas);
-  split_columns(power_rows(minus_w, inverse_area, system.free_vertices, options), system);
-  if (system.symmetric) {
-    // Exactly symmetric (the products above agree with their transposes only to round-off).
-    const SparseMatrix transposed = system.matrix.transpose();
-    system.matrix = 0.5 * (system.matrix + transposed);
-  }
-  system.matrix.makeCompressed();
-  system.coupling.makeCompressed();
-  return system;
+  return KHarmonicAssembler(mesh).assemble(region, options);
 }
 
 Eigen::MatrixXd positions_matrix(const Mesh& mesh) {

@@ -74,11 +74,40 @@ struct KHarmonicSystem {
   Eigen::MatrixXd gather_constrained(const Eigen::MatrixXd& positions) const;
 };
 
-/// Assembles the system of the region on `mesh` (see the top of this file). Throws
-/// InvalidArgument when the label vector does not have one entry per vertex, a label is below
-/// kFixed, k is not 1, 2 or 3, nothing is free, a handle index in [0, handle_count()) has no
-/// vertex or touches no free vertex, or a mesh component has free vertices but no constrained
-/// one (the system would be singular). The message names the offending vertex or handle.
+/// The parts of every region's system that depend on the mesh alone (−W, the mixed areas, the
+/// vertex adjacency, the connected components), computed once: an editor keeps one for its base
+/// and assembles each region's system from it (factor once, assemble many). assemble() builds
+/// the free rows directly, in parallel, at a cost of the free rows' k-ring stencils plus linear
+/// passes over the labels; the Mean and MixedSymmetric matrices come out symmetric bit for bit.
+class KHarmonicAssembler {
+public:
+  /// Copies what it needs from `mesh` (which may change or go afterwards). `threads`: 0 = all.
+  explicit KHarmonicAssembler(const Mesh& mesh, int threads = 0);
+
+  /// The system of `region` (see the top of this file), its free vertices in vertex order.
+  /// Throws InvalidArgument when the label vector does not have one entry per vertex, a label is
+  /// below kFixed, k is not 1, 2 or 3, nothing is free, a handle index in [0, handle_count()) has
+  /// no vertex or touches no free vertex, or a mesh component has free vertices but no
+  /// constrained one (the system would be singular). The message names the offending vertex or
+  /// handle.
+  KHarmonicSystem assemble(const Region& region, const KHarmonicOptions& options = {}) const;
+
+  std::size_t vertex_count() const { return static_cast<std::size_t>(offsets_.size() - 1); }
+  /// −W (column-major, symmetric).
+  const SparseMatrix& minus_w() const { return minus_w_; }
+
+private:
+  void check_handles_and_components(const Region& region) const;
+
+  SparseMatrix minus_w_;
+  Eigen::VectorXd inverse_area_;        // 1 / mixed area, floored (see kharmonic.cpp)
+  std::vector<int> offsets_, adjacent_; // the one-ring of every vertex (edges of the mesh)
+  std::vector<int> component_;          // connected component of every vertex
+  int components_ = 0;
+  int threads_ = 0;
+};
+
+/// KHarmonicAssembler(mesh).assemble(region, options): one region's system.
 KHarmonicSystem assemble_kharmonic(const Mesh& mesh, const Region& region,
                                    const KHarmonicOptions& options = {});
 

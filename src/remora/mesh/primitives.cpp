@@ -329,4 +329,37 @@ Mesh make_torus(int around, int tube, double major_radius, double minor_radius) 
   return build(points, triangles);
 }
 
+Mesh make_cylinder(int rings, int segments, double radius, double height) {
+  require_count("make_cylinder", "rings", rings, 1);
+  require_count("make_cylinder", "segments", segments, 3);
+  require_length("make_cylinder", "radius", radius);
+  require_length("make_cylinder", "height", height);
+  require_size("make_cylinder", std::int64_t{rings + 1} * segments,
+               std::int64_t{2} * rings * segments);
+  std::vector<Vec3> points;
+  for (int k = 0; k <= rings; ++k) {
+    const double z = height * k / rings;
+    for (int s = 0; s < segments; ++s) {
+      const double phi = 2.0 * std::numbers::pi * (s + (k % 2 ? 0.5 : 0.0)) / segments;
+      points.emplace_back(radius * std::cos(phi), radius * std::sin(phi), z);
+    }
+  }
+  const auto index = [segments](int k, int s) { return k * segments + s % segments; };
+  std::vector<Triangle> triangles;
+  for (int k = 0; k < rings; ++k) {
+    for (int s = 0; s < segments; ++s) {
+      // Angles increase counter-clockwise seen from +z: (later on the circle, above) turns
+      // outward.
+      if (k % 2 == 0) {
+        triangles.push_back({index(k, s), index(k, s + 1), index(k + 1, s)});
+        triangles.push_back({index(k, s + 1), index(k + 1, s + 1), index(k + 1, s)});
+      } else {
+        triangles.push_back({index(k, s), index(k + 1, s + 1), index(k + 1, s)});
+        triangles.push_back({index(k, s), index(k, s + 1), index(k + 1, s + 1)});
+      }
+    }
+  }
+  return build(points, triangles);
+}
+
 } // namespace remora

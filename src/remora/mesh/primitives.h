@@ -64,4 +64,13 @@ Mesh make_cube(int n, double size);
 /// centre). around, tube >= 3, 0 < minor_radius < major_radius.
 Mesh make_torus(int around, int tube, double major_radius, double minor_radius);
 
+/// An open cylinder about the z axis from z = 0 to z = height: rings + 1 circles of `segments`
+/// vertices; circle k lies at z = k height / rings, and its vertex s at the angle
+/// 2 pi (s + (k odd ? 1/2 : 0)) / segments, index k segments + s. Neighbouring circles are joined
+/// by a strip of 2 segments triangles (a triangular lattice: with height / rings = sqrt(3)/2 times
+/// the chord 2 pi radius / segments every triangle is near equilateral). V = (rings + 1)
+/// segments, F = 2 rings segments, two boundary loops (the circles k = 0 and k = rings), oriented
+/// outward. rings >= 1, segments >= 3.
+Mesh make_cylinder(int rings, int segments, double radius, double height);
+
 } // namespace remora

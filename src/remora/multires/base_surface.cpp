@@ -8,6 +8,7 @@
 #include <utility>
 #include <vector>
 
+#include <Eigen/IterativeLinearSolvers>
 #include <Eigen/SparseCore>
 #include <fmt/format.h>
 
@@ -198,7 +199,8 @@ Sparse loop_system(const Mesh& mesh, const RowBlocks& rows, double sigma_max, do
 } // namespace
 
 LowPassFilter::LowPassFilter(const Mesh& mesh, const LowPassOptions& options)
-    : n_(static_cast<Eigen::Index>(mesh.n_vertices())), steps_(options.steps) {
+    : n_(static_cast<Eigen::Index>(mesh.n_vertices())), tolerance_(options.tolerance),
+      steps_(options.steps) {
   check_options(options);
   stats_.sigma = stats_.sigma_min = options.smoothing * length_scale(mesh).length;
   if (!(stats_.sigma > 0.0)) return; // identity
@@ -218,29 +220,20 @@ LowPassFilter::LowPassFilter(const Mesh& mesh, const LowPassOptions& options)
   const double scale = uniform ? stats_.sigma * stats_.sigma : 1.0;
 
   RowBlocks rows = row_blocks(mesh);
-  Sparse a;
   std::vector<Eigen::Triplet<double>> couple;
-  interior_system(lap.weights, mass, scale, rows, a, mass_, couple);
+  interior_system(lap.weights, mass, scale, rows, system_, mass_, couple);
   lap.weights.resize(0, 0);
   stats_.laplacian_stats = std::move(lap);
-  SolverOptions solver_options;
-  solver_options.name = "cg";
-  solver_options.tolerance = options.tolerance;
-  if (!rows.interior.empty()) {
-    solver_ = make_solver(solver_options);
-    solver_->compute(a);
-  }
   coupling_.resize(static_cast<Eigen::Index>(rows.interior.size()),
                    static_cast<Eigen::Index>(rows.boundary.size()));
   coupling_.setFromTriplets(couple.begin(), couple.end());
-  if (!rows.boundary.empty()) {
-    const Sparse loops = loop_system(mesh, rows, stats_.sigma, options.feature_cap, boundary_mass_,
-                                     stats_.capped_loops);
-    boundary_solver_ = make_solver(solver_options);
-    boundary_solver_->compute(loops);
-  }
+  if (!rows.boundary.empty())
+    loops_ = loop_system(mesh, rows, stats_.sigma, options.feature_cap, boundary_mass_,
+                         stats_.capped_loops);
   interior_ = std::move(rows.interior);
   boundary_ = std::move(rows.boundary);
+  place_ = std::move(rows.place);
+  on_boundary_ = std::move(rows.on_boundary);
   solved_ = true;
 }
 
@@ -248,7 +241,55 @@ LowPassFilter::LowPassFilter(LowPassFilter&&) noexcept = default;
 LowPassFilter& LowPassFilter::operator=(LowPassFilter&&) noexcept = default;
 LowPassFilter::~LowPassFilter() = default;
 
-Eigen::MatrixXd LowPassFilter::apply(const Eigen::MatrixXd& values) {
+namespace {
+
+// Solves a x = b column by column by Jacobi-preconditioned CG (a SPD, both triangles stored),
+// from `guess` when given; throws NumericalError when a column misses the tolerance.
+Eigen::MatrixXd cg_solve(const Sparse& a, const Eigen::MatrixXd& b, const Eigen::MatrixXd* guess,
+                         double tolerance) {
+  Eigen::ConjugateGradient<Sparse, Eigen::Lower | Eigen::Upper,
+                           Eigen::DiagonalPreconditioner<double>>
+      cg;
+  cg.setTolerance(tolerance);
+  cg.setMaxIterations(static_cast<int>(std::max<Eigen::Index>(10 * a.rows(), 100)));
+  cg.compute(a);
+  Eigen::MatrixXd x(b.rows(), b.cols());
+  for (Eigen::Index c = 0; c < b.cols(); ++c) {
+    if (b.col(c).squaredNorm() == 0) {
+      x.col(c).setZero();
+      continue;
+    }
+    if (guess)
+      x.col(c) = cg.solveWithGuess(b.col(c), guess->col(c));
+    else
+      x.col(c) = cg.solve(b.col(c));
+    if (cg.info() != Eigen::Success || !x.col(c).allFinite())
+      throw NumericalError(fmt::format(
+          "low-pass filter: CG did not converge after {} iterations (relative residual {:.3g}, "
+          "tolerance {:.3g}); lower the smoothing or repair the mesh",
+          cg.iterations(), cg.error(), tolerance));
+  }
+  return x;
+}
+
+// The rows and columns `keep` of the symmetric matrix a (CSC, both triangles); `local` maps a's
+// indices to positions in `keep` (−1 elsewhere).
+Sparse principal_block(const Sparse& a, const std::vector<Eigen::Index>& keep,
+                       const std::vector<int>& local) {
+  std::vector<Eigen::Triplet<double>> t;
+  for (std::size_t c = 0; c < keep.size(); ++c)
+    for (Sparse::InnerIterator it(a, keep[c]); it; ++it) {
+      const int r = local[static_cast<std::size_t>(it.row())];
+      if (r >= 0) t.emplace_back(r, static_cast<int>(c), it.value());
+    }
+  Sparse block(static_cast<Eigen::Index>(keep.size()), static_cast<Eigen::Index>(keep.size()));
+  block.setFromTriplets(t.begin(), t.end());
+  return block;
+}
+
+} // namespace
+
+Eigen::MatrixXd LowPassFilter::apply(const Eigen::MatrixXd& values) const {
   if (values.rows() != n_)
     throw InvalidArgument(
         fmt::format("low-pass filter: {} rows given for a mesh of {} vertices", values.rows(), n_));
@@ -259,23 +300,80 @@ Eigen::MatrixXd LowPassFilter::apply(const Eigen::MatrixXd& values) {
   Eigen::MatrixXd xi(ni, cols), xb(nb, cols);
   for (Eigen::Index i = 0; i < ni; ++i) xi.row(i) = values.row(interior_[std::size_t(i)]);
   for (Eigen::Index i = 0; i < nb; ++i) xb.row(i) = values.row(boundary_[std::size_t(i)]);
-  stats_.iterations = 0;
   for (int s = 0; s < steps_; ++s) {
     if (nb > 0) {
       const Eigen::MatrixXd b = boundary_mass_.asDiagonal() * xb;
-      xb = boundary_solver_->solve(b, &xb);
-      stats_.iterations = std::max(stats_.iterations, boundary_solver_->stats().iterations);
+      xb = cg_solve(loops_, b, &xb, tolerance_);
     }
     if (ni > 0) {
       Eigen::MatrixXd b = mass_.asDiagonal() * xi;
       if (nb > 0) b += coupling_ * xb;
-      xi = solver_->solve(b, &xi);
-      stats_.iterations = std::max(stats_.iterations, solver_->stats().iterations);
+      xi = cg_solve(system_, b, &xi, tolerance_);
     }
   }
   Eigen::MatrixXd x(n_, cols);
   for (Eigen::Index i = 0; i < ni; ++i) x.row(interior_[std::size_t(i)]) = xi.row(i);
   for (Eigen::Index i = 0; i < nb; ++i) x.row(boundary_[std::size_t(i)]) = xb.row(i);
+  return x;
+}
+
+Eigen::MatrixXd LowPassFilter::apply_local(const std::vector<int>& region,
+                                           const Eigen::MatrixXd& values) const {
+  if (values.rows() != static_cast<Eigen::Index>(region.size()))
+    throw InvalidArgument(fmt::format("low-pass filter: {} rows given for a region of {} vertices",
+                                      values.rows(), region.size()));
+  for (const int v : region)
+    if (v < 0 || v >= n_)
+      throw InvalidArgument(fmt::format(
+          "low-pass filter: region vertex {} is out of range (the mesh has {} vertices)", v, n_));
+  if (!solved_) return values;
+  // The region's rows of each block (interior, boundary) and their places in the region.
+  std::vector<Eigen::Index> inner, outer;           // block rows
+  std::vector<Eigen::Index> inner_rows, outer_rows; // rows of `values`
+  for (std::size_t r = 0; r < region.size(); ++r) {
+    const auto v = static_cast<std::size_t>(region[r]);
+    (on_boundary_[v] ? outer : inner).push_back(place_[v]);
+    (on_boundary_[v] ? outer_rows : inner_rows).push_back(static_cast<Eigen::Index>(r));
+  }
+  std::vector<int> local_inner(interior_.size(), -1), local_outer(boundary_.size(), -1);
+  for (std::size_t k = 0; k < inner.size(); ++k)
+    local_inner[static_cast<std::size_t>(inner[k])] = static_cast<int>(k);
+  for (std::size_t k = 0; k < outer.size(); ++k)
+    local_outer[static_cast<std::size_t>(outer[k])] = static_cast<int>(k);
+  const Eigen::Index cols = values.cols();
+  Eigen::MatrixXd xi(static_cast<Eigen::Index>(inner.size()), cols);
+  Eigen::MatrixXd xb(static_cast<Eigen::Index>(outer.size()), cols);
+  Eigen::VectorXd mi(xi.rows()), mb(xb.rows());
+  for (Eigen::Index k = 0; k < xi.rows(); ++k) {
+    xi.row(k) = values.row(inner_rows[std::size_t(k)]);
+    mi[k] = mass_[inner[std::size_t(k)]];
+  }
+  for (Eigen::Index k = 0; k < xb.rows(); ++k) {
+    xb.row(k) = values.row(outer_rows[std::size_t(k)]);
+    mb[k] = boundary_mass_[outer[std::size_t(k)]];
+  }
+  const Sparse a = principal_block(system_, inner, local_inner);
+  const Sparse loops = xb.rows() > 0 ? principal_block(loops_, outer, local_outer) : Sparse();
+  // t W between the region's interior and boundary rows.
+  std::vector<Eigen::Triplet<double>> t;
+  for (std::size_t c = 0; c < outer.size(); ++c)
+    for (Sparse::InnerIterator it(coupling_, outer[c]); it; ++it) {
+      const int r = local_inner[static_cast<std::size_t>(it.row())];
+      if (r >= 0) t.emplace_back(r, static_cast<int>(c), it.value());
+    }
+  Sparse couple(xi.rows(), xb.rows());
+  couple.setFromTriplets(t.begin(), t.end());
+  for (int s = 0; s < steps_; ++s) {
+    if (xb.rows() > 0) xb = cg_solve(loops, mb.asDiagonal() * xb, &xb, tolerance_);
+    if (xi.rows() > 0) {
+      Eigen::MatrixXd b = mi.asDiagonal() * xi;
+      if (xb.rows() > 0) b += couple * xb;
+      xi = cg_solve(a, b, &xi, tolerance_);
+    }
+  }
+  Eigen::MatrixXd x(values.rows(), cols);
+  for (Eigen::Index k = 0; k < xi.rows(); ++k) x.row(inner_rows[std::size_t(k)]) = xi.row(k);
+  for (Eigen::Index k = 0; k < xb.rows(); ++k) x.row(outer_rows[std::size_t(k)]) = xb.row(k);
   return x;
 }
 

@@ -15,7 +15,13 @@
 // Strength: t = σ², σ = smoothing × the mesh's length scale (its mean edge length unless needles
 // inflate it: geometry/measures.h, length_scale()). A Laplacian eigenfunction of
 // wavelength λ is scaled by 1 / (1 + (2πσ/λ)²) per step: wavelengths below 2πσ lose at least half.
-// The filter is factored once (a Jacobi-preconditioned CG set-up) and applied to any positions.
+// The filter is set up once and applied to any positions (Jacobi-preconditioned CG solves).
+//
+// Locality: the filter's kernel (M − t W)⁻¹ M is a screened Poisson kernel, which decays like
+// exp(−d/σ) with the distance d along the surface. apply_local() solves the same system on a
+// vertex set only, the values outside taken as zero: for values that vanish outside a region, the
+// result on the region grown by a band of a few σ matches apply() up to that decay (the editor's
+// local bake, multires/bake.h, uses it for the change of an edit).
 //
 // Feature cap: a tube or a hole of radius r is such a short wavelength; one step scales its
 // radius by about 1 / (1 + σ²/r²), so a hole smaller than σ closes into a neck and an arm
@@ -37,7 +43,6 @@
 #include <Eigen/SparseCore>
 
 #include "remora/geometry/intrinsic.h"
-#include "remora/linalg/solver.h"
 #include "remora/mesh/mesh.h"
 
 namespace remora {
@@ -64,7 +69,6 @@ struct LowPassStats {
   std::size_t capped = 0;             ///< vertices whose σ_i < σ
   std::size_t capped_loops = 0;       ///< boundary loops filtered with a σ below σ
   IntrinsicLaplacian laplacian_stats; ///< flips, clamps (weights and mass are not kept here)
-  int iterations = 0; ///< CG iterations of the last apply(), the most over the columns
 };
 
 /// The filter's σ per vertex (by idx()) for an absolute σ `sigma`: the cap and its relaxation
@@ -84,21 +88,32 @@ public:
 
   /// The filtered values of `values` (n_vertices × any number of columns, e.g. positions).
   /// Isolated vertices keep their values. Throws InvalidArgument for a wrong row count and
+  /// NumericalError if CG does not converge. Const and thread-safe: the filter may be shared.
+  Eigen::MatrixXd apply(const Eigen::MatrixXd& values) const;
+  /// The same system solved on the vertices `region` only (distinct ids; row r of `values` and
+  /// of the result belong to vertex region[r]), with every value outside the region taken as 0:
+  /// the boundary loops' curve system on the region's boundary vertices, then the interior one
+  /// on its interior vertices. For values that are 0 outside a set X, the result differs from
+  /// apply()'s on the region by about exp(−d/σ) × the values' size, d the distance from X to
+  /// the region's border. Throws InvalidArgument for an id out of range or a wrong row count,
   /// NumericalError if CG does not converge.
-  Eigen::MatrixXd apply(const Eigen::MatrixXd& values);
+  Eigen::MatrixXd apply_local(const std::vector<int>& region, const Eigen::MatrixXd& values) const;
 
   const LowPassStats& stats() const { return stats_; }
 
 private:
   Eigen::Index n_ = 0;
-  // Interior vertices (all of them on a closed mesh), then boundary vertices: their row indices.
+  // Interior vertices (all of them on a closed mesh), then boundary vertices: their row indices,
+  // and per vertex its row in its own block.
   std::vector<Eigen::Index> interior_, boundary_;
+  std::vector<Eigen::Index> place_;
+  std::vector<char> on_boundary_;
   Eigen::VectorXd mass_, boundary_mass_;
+  Eigen::SparseMatrix<double> system_;   // (M − t W) on the interior rows and columns
   Eigen::SparseMatrix<double> coupling_; // t W restricted to interior rows, boundary columns
-  // The interior system; null when smoothing == 0 or when no vertex is interior.
-  std::unique_ptr<Solver> solver_;
-  std::unique_ptr<Solver> boundary_solver_; // the loops' curve system; null without boundary
-  bool solved_ = false;                     // false: smoothing == 0, the identity
+  Eigen::SparseMatrix<double> loops_;    // the loops' curve system on the boundary block
+  double tolerance_ = 1e-10;
+  bool solved_ = false; // false: smoothing == 0, the identity
   int steps_ = 1;
   LowPassStats stats_;
 };

@@ -1,7 +1,8 @@
 // An edit as data: what `remora edit --edit EDIT.json` reads and what the server receives. The
 // format is documented with examples in docs/editing.md (a test runs those examples):
 //
-//   { "k": 2, "solver": "cholmod", "areas": "mean", "details": "normal", "remesh": true,
+//   { "k": 2, "solver": "cholmod", "areas": "mean", "details": "normal", "method": "linear",
+//     "remesh": true,
 //     "base_smoothing": 2.0, "base_feature_cap": 1.0,
 //     "support": <region>,
 //     "handles": [ { "region": <region>, "transform": <transform> }, ... ] }
@@ -57,7 +58,7 @@ struct HandleSpec {
 
 struct EditRequest {
   std::optional<int> k;
-  std::optional<std::string> solver, areas, details;
+  std::optional<std::string> solver, areas, details, method;
   std::optional<bool> remesh;
   std::optional<double> base_smoothing, base_feature_cap;
   RegionSpec support;

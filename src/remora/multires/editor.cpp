@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <deque>
+#include <limits>
 #include <optional>
 #include <utility>
 
@@ -18,6 +20,7 @@
 #include "remora/multires/frame.h"
 #include "remora/multires/limits.h"
 #include "remora/multires/multigrid.h"
+#include "remora/multires/nonlinear_region.h"
 
 namespace remora {
 namespace {
@@ -50,9 +53,15 @@ DetailMode parse_detail_mode(const std::string& name) {
 
 // ---- the editor ------------------------------------------------------------------------------
 
-namespace {
-
-struct RegionState {
+/// A region of the editor: its labels, basis functions, details and the frame's state; with the
+/// report it was made with (set_region's figures) and the editor that made it.
+struct Editor::Prepared::State {
+  const void* owner = nullptr;
+  EditReport report;
+  // What it was prepared from (set_region's arguments and the system), to find it again.
+  std::vector<int> support;
+  std::vector<std::vector<int>> handle_ids;
+  KHarmonicOptions system;
   std::vector<int> input_label; // per O vertex: kFixed, kFree or handle j
   std::vector<int> base_label;  // per B vertex
   int handles = 0;
@@ -62,33 +71,44 @@ struct RegionState {
   std::vector<Eigen::Vector3d> handle_centers;
   Eigen::MatrixXd rest;         // B0
   Eigen::MatrixXd rest_normals; // of B0
-  std::vector<int> encoded;     // O vertices, in the order of `details`
-  std::vector<PhongDetail> details;
-  std::vector<Eigen::Vector3d> rest_offsets; // DetailMode::Displacement: p − b on B0
-  NormalPlan affected;                       // B vertices whose normal can change, and their faces
+  std::vector<int> encoded;     // O vertices with a detail, in increasing order
+  FrameDetails details;         // their details, decoded into the rows `encoded`
+  NormalPlan affected;          // B vertices whose normal can change, and their faces
   std::vector<Transform> transforms;
-  RowPoints current_base, current_normals; // a vertex's x, y, z together: the frame's reads
+  FrameRows frame; // B under the transforms: positions and normals
   Eigen::MatrixXd current_positions;
   std::vector<double> face_normals; // update_normals()'s scratch
   bool dirty = true;
+  std::unique_ptr<NonlinearRegion> nonlinear; // method nonlinear (multires/nonlinear_region.h)
+  std::shared_ptr<const RemeshResult> coarse; // its preview level (kept by the editor)
+  std::uint64_t bytes = 0; // its estimated memory (region_bytes() of multires/limits.h)
 };
 
-} // namespace
+using RegionState = Editor::Prepared::State;
 
 struct Editor::Impl {
   EditorOptions options;
   Mesh input;
   Eigen::MatrixXd input_positions;
   TriangleTopology input_topology;
-  std::optional<LowPassFilter> filter;
+  std::shared_ptr<const LowPassFilter> filter; // immutable: editors made by a bake share it
+  Eigen::MatrixXd smooth;                      // S = filter(O)
   Mesh base;
   TriangleTopology topology;
-  Eigen::MatrixXd base_rest; // B
+  Eigen::MatrixXd base_rest;    // B
+  Eigen::MatrixXd base_normals; // of B
   std::vector<SurfacePoint> base_on_input, input_on_base;
   std::vector<std::pair<int, int>> negative_edges; // of B
+  std::optional<KHarmonicAssembler> assembler;     // B's systems
+  BaseStatistics statistics;                       // of B: what a bake updates the report from
   std::unique_ptr<MultigridSolver> multigrid;
+  std::shared_ptr<const RemeshResult> coarse; // method nonlinear's preview level, for every region
   EditReport report;
   std::unique_ptr<RegionState> region;
+  // The regions installed before the current one, the latest first: set_region() of one of them
+  // again (an undo) installs it as it was, without the work.
+  std::deque<std::unique_ptr<RegionState>> recent;
+  static constexpr std::size_t kRecentRegions = 2;
 
   void progress(std::string_view phase, int step, int steps) const {
     if (options.progress) options.progress(phase, step, steps);
@@ -101,38 +121,30 @@ struct Editor::Impl {
     if (!region) throw InvalidArgument("no region yet: call set_region() first");
     return *region;
   }
-  void update();
+  void update(double budget_ms);
+  void build_nonlinear(RegionState& r, EditReport& into);
+  void deform_base(RegionState& r, bool moved, double budget_ms);
 
   // The steps of set_region(), in order, on a new state (the current region stays until all
   // succeed).
   std::unique_ptr<RegionState> paint(const std::vector<int>& support,
                                      const std::vector<std::vector<int>>& handles) const;
   void map_to_base(RegionState& r) const;
-  void report_region(const RegionState& r);
+  void report_region(const RegionState& r, EditReport& out) const;
   Eigen::MatrixXd constrained_values(const RegionState& r, const std::vector<int>& vertices,
                                      bool by_vertex) const;
-  void solve_basis(RegionState& r);
-  void encode_details(RegionState& r);
+  void solve_basis(RegionState& r, EditReport& out, const std::stop_token& stop);
+  void encode_details(RegionState& r, EditReport& out, const std::stop_token& stop) const;
   void find_affected(RegionState& r) const;
+
+  // The memory limit (options.memory_bytes; 0 = none). The preprocessing's estimate, by the input
+  // triangles.
+  std::uint64_t preprocessing_bytes() const { return kEditorBytesPerTriangle * input.n_faces(); }
+  void bytes_for(RegionState& r) const;
+  void make_room(std::uint64_t beside);
 };
 
 namespace {
-
-/// Throws InvalidArgument when the region's estimated memory and the preprocessing's of
-/// `triangles` input triangles exceed o.memory_bytes.
-void check_region_memory(const EditorOptions& o, std::size_t triangles, const RegionState& r) {
-  if (o.memory_bytes == 0) return;
-  const auto free_vertices =
-      static_cast<std::size_t>(std::count(r.base_label.begin(), r.base_label.end(), Region::kFree));
-  const std::uint64_t held = kEditorBytesPerTriangle * triangles;
-  const std::uint64_t need = region_bytes(free_vertices, o.system.k, r.handles);
-  if (held + need <= o.memory_bytes) return;
-  throw InvalidArgument(fmt::format(
-      "the region has {} free base vertices: at k = {} with {} handle{} it needs about {} MB, "
-      "more than the {} MB left to a region here (paint a smaller support, or use a lower k)",
-      free_vertices, o.system.k, r.handles, r.handles == 1 ? "" : "s", need / 1000000,
-      (o.memory_bytes > held ? o.memory_bytes - held : 0) / 1000000));
-}
 
 void check_options(const EditorOptions& o) {
   if (o.system.k < 1 || o.system.k > 3)
@@ -183,8 +195,8 @@ Editor::Editor(Mesh mesh, EditorOptions options) : impl_(std::make_unique<Impl>(
   auto t0 = Clock::now();
   LowPassOptions filter_options = m.options.base;
   if (filter_options.threads == 0) filter_options.threads = m.options.threads;
-  m.filter.emplace(m.input, filter_options);
-  const Eigen::MatrixXd smooth = m.filter->apply(m.input_positions);
+  m.filter = std::make_shared<const LowPassFilter>(m.input, filter_options);
+  m.smooth = m.filter->apply(m.input_positions);
   m.report.sigma = m.filter->stats().sigma;
   m.report.sigma_min = m.filter->stats().sigma_min;
   m.report.sigma_capped_vertices = m.filter->stats().capped;
@@ -192,7 +204,7 @@ Editor::Editor(Mesh mesh, EditorOptions options) : impl_(std::make_unique<Impl>(
   m.report.intrinsic_flips = m.filter->stats().laplacian_stats.flips;
   m.report.input_negative_weights = m.filter->stats().laplacian_stats.negative_before;
   Mesh s = m.input;
-  set_positions(s, smooth);
+  set_positions(s, m.smooth);
   m.report.milliseconds["base"] = ms_since(t0);
 
   // 3. The base B: the area-equalizing remesh of S, with the correspondence.
@@ -224,19 +236,52 @@ Editor::Editor(Mesh mesh, EditorOptions options) : impl_(std::make_unique<Impl>(
   }
   m.topology = triangle_topology(m.base);
   m.base_rest = positions_matrix(m.base);
+  m.base_normals = vertex_normals(m.topology, m.base_rest);
   m.report.milliseconds["remesh"] = ms_since(t0);
   m.report.base_vertices = m.base.n_vertices();
   m.report.base_faces = m.base.n_faces();
 
   t0 = Clock::now();
-  const Eigen::SparseMatrix<double> w = cotan_weights(m.base);
-  for (Eigen::Index c = 0; c < w.outerSize(); ++c)
-    for (Eigen::SparseMatrix<double>::InnerIterator it(w, c); it; ++it)
-      if (it.row() < it.col() && it.value() < 0.0)
+  m.assembler.emplace(m.base, m.options.threads);
+  const SparseMatrix& minus_w = m.assembler->minus_w();
+  for (Eigen::Index c = 0; c < minus_w.outerSize(); ++c)
+    for (SparseMatrix::InnerIterator it(minus_w, c); it; ++it)
+      if (it.row() < it.col() && it.value() > 0.0)
         m.negative_edges.emplace_back(static_cast<int>(it.row()), static_cast<int>(it.col()));
   m.report.base_symmetry_defect = laplacian_symmetry_defect(m.base);
   m.report.base_quality = mesh_quality(m.base);
+  m.statistics = base_statistics(m.base);
   m.report.milliseconds["base report"] = ms_since(t0);
+}
+
+Editor::Editor(EditorParts parts, EditorOptions options) : impl_(std::make_unique<Impl>()) {
+  Impl& m = *impl_;
+  check_options(options);
+  const auto ni = static_cast<Eigen::Index>(parts.input.n_vertices());
+  const auto nb = static_cast<Eigen::Index>(parts.base.n_vertices());
+  if (!options.remesh || !parts.filter || parts.input_positions.rows() != ni ||
+      parts.smooth.rows() != ni || parts.input_on_base.size() != std::size_t(ni) ||
+      parts.base_rest.rows() != nb || parts.base_on_input.size() != std::size_t(nb) ||
+      parts.topology.faces.size() != parts.base.n_faces() ||
+      parts.input_topology.faces.size() != parts.input.n_faces())
+    throw InvalidArgument("editor parts: the sizes of the input, the base and their "
+                          "correspondences disagree (or remesh is off)");
+  m.options = std::move(options);
+  m.input = std::move(parts.input);
+  m.input_positions = std::move(parts.input_positions);
+  m.input_topology = std::move(parts.input_topology);
+  m.filter = std::move(parts.filter);
+  m.smooth = std::move(parts.smooth);
+  m.base = std::move(parts.base);
+  m.topology = std::move(parts.topology);
+  m.base_rest = std::move(parts.base_rest);
+  m.base_on_input = std::move(parts.base_on_input);
+  m.input_on_base = std::move(parts.input_on_base);
+  m.negative_edges = std::move(parts.negative_edges);
+  m.statistics = std::move(parts.statistics);
+  m.report = std::move(parts.report);
+  m.base_normals = vertex_normals(m.topology, m.base_rest);
+  m.assembler.emplace(m.base, m.options.threads);
 }
 
 Editor::Editor(Editor&&) noexcept = default;
@@ -318,25 +363,25 @@ void Editor::Impl::map_to_base(RegionState& r) const {
       r.handle_base[static_cast<std::size_t>(r.base_label[v])].push_back(static_cast<int>(v));
 }
 
-// The region's figures, before the solve, so that a failing solve still reports them.
-void Editor::Impl::report_region(const RegionState& r) {
-  report.support_vertices = 0;
-  report.handle_vertices.assign(static_cast<std::size_t>(r.handles), 0);
+// The region's figures (the report takes them only when the whole of set_region succeeds).
+void Editor::Impl::report_region(const RegionState& r, EditReport& out) const {
+  out.support_vertices = 0;
+  out.handle_vertices.assign(static_cast<std::size_t>(r.handles), 0);
   for (const int label : r.input_label) {
-    if (label != Region::kFixed) ++report.support_vertices;
-    if (label >= 0) ++report.handle_vertices[static_cast<std::size_t>(label)];
+    if (label != Region::kFixed) ++out.support_vertices;
+    if (label >= 0) ++out.handle_vertices[static_cast<std::size_t>(label)];
   }
   std::size_t free_count = 0, constrained = 0;
   for (const int label : r.base_label) (label == Region::kFree ? free_count : constrained)++;
-  report.free_base_vertices = free_count;
-  report.constrained_base_vertices = constrained;
-  report.handle_base_vertices.clear();
-  for (const auto& h : r.handle_base) report.handle_base_vertices.push_back(h.size());
-  report.negative_weights_in_support = 0;
+  out.free_base_vertices = free_count;
+  out.constrained_base_vertices = constrained;
+  out.handle_base_vertices.clear();
+  for (const auto& h : r.handle_base) out.handle_base_vertices.push_back(h.size());
+  out.negative_weights_in_support = 0;
   for (const auto& [a, b] : negative_edges)
     if (r.base_label[static_cast<std::size_t>(a)] == Region::kFree ||
         r.base_label[static_cast<std::size_t>(b)] == Region::kFree)
-      ++report.negative_weights_in_support;
+      ++out.negative_weights_in_support;
 }
 
 // The constrained values of the 3 + 4h basis functions, one column each: the fixed vertices'
@@ -366,11 +411,11 @@ Eigen::MatrixXd Editor::Impl::constrained_values(const RegionState& r,
 }
 
 // The system on the base, factored once; the 3 + 4h basis functions.
-void Editor::Impl::solve_basis(RegionState& r) {
+void Editor::Impl::solve_basis(RegionState& r, EditReport& out, const std::stop_token& stop) {
   const Region labels{r.base_label};
   const std::string on_base =
       options.remesh
-          ? fmt::format("on the remeshed base (edge length {:.4g}): ", report.base_target_length)
+          ? fmt::format("on the remeshed base (edge length {:.4g}): ", out.base_target_length)
           : std::string("on the mesh itself: ");
   auto t0 = Clock::now();
   const std::string name = solver_name(options.system.areas != AreaWeights::Mixed);
@@ -385,8 +430,8 @@ void Editor::Impl::solve_basis(RegionState& r) {
         multigrid = std::make_unique<MultigridSolver>(base, mo);
       }
       multigrid->set_region(labels);
-      report.milliseconds["assemble"] = 0.0;
-      report.milliseconds["factor"] = ms_since(t0);
+      out.milliseconds["assemble"] = 0.0;
+      out.milliseconds["factor"] = ms_since(t0);
       t0 = Clock::now();
       std::vector<int> all(base.n_vertices());
       for (std::size_t v = 0; v < all.size(); ++v) all[v] = static_cast<int>(v);
@@ -395,38 +440,41 @@ void Editor::Impl::solve_basis(RegionState& r) {
       int iterations = 0;
       for (const auto& level : multigrid->stats())
         iterations = std::max(iterations, level.iterations);
-      report.solver_stats = SolverStats{};
-      report.solver_stats.iterations = iterations;
+      out.solver_stats = SolverStats{};
+      out.solver_stats.iterations = iterations;
     } else {
-      const KHarmonicSystem system = assemble_kharmonic(base, labels, options.system);
-      report.milliseconds["assemble"] = ms_since(t0);
+      const KHarmonicSystem system = assembler->assemble(labels, options.system);
+      out.milliseconds["assemble"] = ms_since(t0);
       t0 = Clock::now();
       SolverOptions so = options.solver;
       so.name = name;
       const std::unique_ptr<Solver> solver = make_solver(so);
+      if (stop.stop_requested()) return;
       solver->compute(system.matrix);
-      report.milliseconds["factor"] = ms_since(t0);
+      out.milliseconds["factor"] = ms_since(t0);
+      if (stop.stop_requested()) return;
       t0 = Clock::now();
       r.basis =
           solver->solve(system.rhs(constrained_values(r, system.constrained_vertices, false)));
       r.free_vertices = system.free_vertices;
-      report.solver_stats = solver->stats();
+      out.solver_stats = solver->stats();
     }
   } catch (const InvalidArgument& e) {
     throw InvalidArgument(on_base + e.what());
   } catch (const NumericalError& e) {
     throw NumericalError(on_base + e.what());
   }
-  report.milliseconds["solve"] = ms_since(t0);
-  report.solver = name;
-  report.solves = 3 + 4 * r.handles;
+  out.milliseconds["solve"] = ms_since(t0);
+  out.solver = name;
+  out.solves = 3 + 4 * r.handles;
   if (!r.basis.allFinite())
     throw NumericalError(on_base + "the solver returned non-finite values; try a direct solver");
 }
 
-// B0 (the fill-in with the handles undeformed), its normals, and the Phong details of the painted
-// input vertices against it.
-void Editor::Impl::encode_details(RegionState& r) {
+// B0 (the fill-in with the handles undeformed), its normals (B's outside r.affected, where no face
+// moved), and the Phong details of the painted input vertices against it.
+void Editor::Impl::encode_details(RegionState& r, EditReport& out,
+                                  const std::stop_token& stop) const {
   const auto t0 = Clock::now();
   r.rest = base_rest;
   for (std::size_t row = 0; row < r.free_vertices.size(); ++row) {
@@ -435,7 +483,8 @@ void Editor::Impl::encode_details(RegionState& r) {
       p += r.basis.block<1, 3>(static_cast<Eigen::Index>(row), 3 + 4 * j);
     r.rest.row(r.free_vertices[row]) = p;
   }
-  r.rest_normals = vertex_normals(topology, r.rest);
+  r.rest_normals = base_normals;
+  update_vertex_normals(topology, r.rest, r.affected.vertices, r.rest_normals, options.threads);
   std::vector<int> starts;
   for (std::size_t i = 0; i < r.input_label.size(); ++i) {
     const SurfacePoint& sp = input_on_base[i];
@@ -446,19 +495,23 @@ void Editor::Impl::encode_details(RegionState& r) {
   Eigen::MatrixXd points(static_cast<Eigen::Index>(r.encoded.size()), 3);
   for (std::size_t e = 0; e < r.encoded.size(); ++e)
     points.row(static_cast<Eigen::Index>(e)) = input_positions.row(r.encoded[e]);
-  r.details = encode_phong(topology, r.rest, r.rest_normals, points, starts, options.phong,
-                           &report.phong, options.threads);
+  if (stop.stop_requested()) return;
+  const std::vector<PhongDetail> details = encode_phong(
+      topology, r.rest, r.rest_normals, points, starts, options.phong, &out.phong, options.threads);
+  std::vector<Eigen::Vector3d> rest_offsets; // DetailMode::Displacement: p − b on B0
   if (options.details == DetailMode::Displacement) {
-    r.rest_offsets.resize(r.details.size());
-    for (std::size_t e = 0; e < r.details.size(); ++e) {
-      PhongDetail foot = r.details[e];
+    rest_offsets.resize(details.size());
+    for (std::size_t e = 0; e < details.size(); ++e) {
+      PhongDetail foot = details[e];
       foot.offset = 0.0;
       foot.residual = false;
-      r.rest_offsets[e] = points.row(static_cast<Eigen::Index>(e)).transpose() -
-                          decode_phong(topology, r.rest, r.rest_normals, foot);
+      rest_offsets[e] = points.row(static_cast<Eigen::Index>(e)).transpose() -
+                        decode_phong(topology, r.rest, r.rest_normals, foot);
     }
   }
-  report.milliseconds["encode"] = ms_since(t0);
+  r.details =
+      frame_details(details, r.encoded, options.details == DetailMode::Normal, rest_offsets);
+  out.milliseconds["encode"] = ms_since(t0);
 }
 
 // The base vertices whose normals can change: every corner of a face with a moving vertex.
@@ -475,25 +528,162 @@ void Editor::Impl::find_affected(RegionState& r) const {
   r.affected = plan_normals(topology, vertices);
 }
 
-void Editor::set_region(const std::vector<int>& support,
-                        const std::vector<std::vector<int>>& handles) {
+// Method nonlinear: its deformers from B0, the labels and the handles' scalar weights (the basis
+// functions' "1" columns); for a large support the coarse base of its preview, made once and
+// kept while the regions' sizes call for about the same coarse edge length.
+void Editor::Impl::build_nonlinear(RegionState& r, EditReport& into) {
+  const auto t0 = Clock::now();
+  Eigen::MatrixXd weights = Eigen::MatrixXd::Zero(r.rest.rows(), r.handles);
+  for (std::size_t row = 0; row < r.free_vertices.size(); ++row)
+    for (int j = 0; j < r.handles; ++j)
+      weights(r.free_vertices[row], j) =
+          static_cast<double>(r.basis(static_cast<Eigen::Index>(row), 3 + 4 * j + 3));
+  for (int j = 0; j < r.handles; ++j)
+    for (const int v : r.handle_base[static_cast<std::size_t>(j)]) weights(v, j) = 1.0;
+  NonlinearOptions o = options.nonlinear;
+  o.threads = options.threads;
+  const std::size_t n_free = r.free_vertices.size();
+  const bool preview =
+      o.preview_vertices > 0 && n_free > 2 * static_cast<std::size_t>(o.preview_vertices);
+  if (preview) {
+    const double wanted = coarse_length(mean_edge_length(base), n_free, o);
+    r.coarse = coarse;
+    if (!r.coarse || std::abs(mean_edge_length(r.coarse->mesh) / wanted - 1.0) > 0.5) {
+      const auto t1 = Clock::now();
+      r.coarse = std::make_shared<const RemeshResult>(make_coarse_base(base, n_free, o));
+      into.milliseconds["nonlinear coarse base"] = ms_since(t1);
+    }
+  }
+  r.nonlinear = std::make_unique<NonlinearRegion>(base, preview ? r.coarse.get() : nullptr, r.rest,
+                                                  r.base_label, weights, o);
+  into.milliseconds["nonlinear setup"] = ms_since(t0);
+}
+
+// Method nonlinear, in a frame: r.current_base holds the blend (the linear result); the region's
+// nonlinear state replaces its free rows, or leaves the blend with a message.
+void Editor::Impl::deform_base(RegionState& r, bool moved, double budget_ms) {
+  if (!r.nonlinear) { // after set_method()
+    build_nonlinear(r, report);
+    if (r.coarse) coarse = r.coarse;
+  }
+  const auto t0 = Clock::now();
+  RowPoints positions = r.frame.leftCols<3>();
+  r.nonlinear->frame(r.transforms, moved, budget_ms, positions);
+  r.frame.leftCols<3>() = positions;
+  report.method = "nonlinear";
+  report.nonlinear = r.nonlinear->stats();
+  report.nonlinear_level = r.nonlinear->level();
+  report.fallback = r.nonlinear->fallback();
+  report.milliseconds["frame nonlinear"] = ms_since(t0);
+}
+
+// Sets r.bytes; throws InvalidArgument when the region and the preprocessing exceed the limit.
+void Editor::Impl::bytes_for(RegionState& r) const {
+  const auto free_vertices =
+      static_cast<std::size_t>(std::count(r.base_label.begin(), r.base_label.end(), Region::kFree));
+  r.bytes = region_bytes(free_vertices, options.system.k, r.handles);
+  const std::uint64_t held = preprocessing_bytes();
+  if (options.memory_bytes == 0 || held + r.bytes <= options.memory_bytes) return;
+  throw InvalidArgument(fmt::format(
+      "the region has {} free base vertices: at k = {} with {} handle{} it needs about {} MB, "
+      "more than the {} MB left to a region here (paint a smaller support, or use a lower k)",
+      free_vertices, options.system.k, r.handles, r.handles == 1 ? "" : "s", r.bytes / 1000000,
+      (options.memory_bytes > held ? options.memory_bytes - held : 0) / 1000000));
+}
+
+// The regions kept for an undo go, the oldest first, until `beside` bytes of regions fit beside
+// them and the preprocessing.
+void Editor::Impl::make_room(std::uint64_t beside) {
+  if (options.memory_bytes == 0) return;
+  const auto kept = [&] {
+    std::uint64_t sum = 0;
+    for (const auto& r : recent) sum += r->bytes;
+    return sum;
+  };
+  while (!recent.empty() && preprocessing_bytes() + beside + kept() > options.memory_bytes)
+    recent.pop_back();
+}
+
+Editor::Prepared::Prepared() = default;
+Editor::Prepared::Prepared(Prepared&&) noexcept = default;
+Editor::Prepared& Editor::Prepared::operator=(Prepared&&) noexcept = default;
+Editor::Prepared::~Prepared() = default;
+
+Editor::Prepared Editor::prepare_region(const std::vector<int>& support,
+                                        const std::vector<std::vector<int>>& handles,
+                                        const std::stop_token& stop) {
   Impl& m = *impl_;
   const auto t_start = Clock::now();
+  const auto check = [&] {
+    if (stop.stop_requested())
+      throw Cancelled("set_region was cancelled; the previous region stays in place");
+  };
+  for (auto it = m.recent.begin(); it != m.recent.end(); ++it) {
+    RegionState& old = **it;
+    if (old.support != support || old.handle_ids != handles || old.system.k != m.options.system.k ||
+        old.system.areas != m.options.system.areas)
+      continue;
+    Prepared prepared;
+    prepared.state_ = std::move(*it);
+    m.recent.erase(it);
+    RegionState& r = *prepared.state_;
+    r.transforms.assign(static_cast<std::size_t>(r.handles), identity_transform());
+    r.dirty = true;
+    r.report.region_reused = true;
+    r.report.milliseconds["set_region"] = ms_since(t_start);
+    return prepared;
+  }
   std::unique_ptr<RegionState> state = m.paint(support, handles);
   RegionState& r = *state;
+  r.owner = impl_.get();
+  r.support = support;
+  r.handle_ids = handles;
+  r.system = m.options.system;
+  r.report = m.report;
+  r.report.region_reused = false;
   m.map_to_base(r);
-  check_region_memory(m.options, m.input.n_faces(), r);
-  m.report_region(r);
-  m.solve_basis(r);
-  m.encode_details(r);
+  m.bytes_for(r);
+  m.make_room(r.bytes);
+  m.report_region(r, r.report);
+  check();
+  m.solve_basis(r, r.report, stop);
+  check();
   m.find_affected(r);
+  m.encode_details(r, r.report, stop);
+  check();
+  if (m.options.method == EditMethod::Nonlinear) m.build_nonlinear(r, r.report);
   r.transforms.assign(static_cast<std::size_t>(r.handles), identity_transform());
-  r.current_base = r.rest;
-  r.current_normals = r.rest_normals;
+  r.frame = frame_rows(r.rest, r.rest_normals);
+  r.rest_normals.resize(0, 0); // in the frame now
   r.current_positions = m.input_positions;
   r.dirty = true;
-  m.region = std::move(state);
-  m.report.milliseconds["set_region"] = ms_since(t_start);
+  r.report.milliseconds["set_region"] = ms_since(t_start);
+  Prepared prepared;
+  prepared.state_ = std::move(state);
+  return prepared;
+}
+
+void Editor::install_region(Prepared&& prepared) {
+  if (!prepared.state_ || prepared.state_->owner != impl_.get())
+    throw InvalidArgument("install_region: the region was not prepared by this editor (or was "
+                          "installed already)");
+  // The report's region figures and set_region's times; the rest stays the editor's.
+  EditReport& r = prepared.state_->report;
+  for (const auto& [key, ms] : impl_->report.milliseconds)
+    if (key.rfind("frame", 0) == 0) r.milliseconds[key] = ms;
+  impl_->report = std::move(r);
+  if (impl_->region) {
+    impl_->recent.push_front(std::move(impl_->region));
+    if (impl_->recent.size() > Impl::kRecentRegions) impl_->recent.pop_back();
+  }
+  if (prepared.state_->coarse) impl_->coarse = prepared.state_->coarse;
+  impl_->region = std::move(prepared.state_);
+  impl_->make_room(impl_->region->bytes);
+}
+
+void Editor::set_region(const std::vector<int>& support,
+                        const std::vector<std::vector<int>>& handles, const std::stop_token& stop) {
+  install_region(prepare_region(support, handles, stop));
 }
 
 namespace {
@@ -518,6 +708,13 @@ void Editor::set_system(const KHarmonicOptions& system) {
   o.system = system;
   check_options(o);
   impl_->options.system = system;
+}
+
+void Editor::set_method(EditMethod method) {
+  Impl& m = *impl_;
+  m.options.method = method;
+  if (!m.region) return;
+  m.region->dirty = true;
 }
 
 Eigen::Vector3d Editor::handle_center(int handle) const {
@@ -551,9 +748,11 @@ const Transform& Editor::transform(int handle) const {
   return r.transforms[static_cast<std::size_t>(handle)];
 }
 
-void Editor::Impl::update() {
+void Editor::Impl::update(double budget_ms) {
   RegionState& r = state();
-  if (!r.dirty) return;
+  const bool iterating =
+      options.method == EditMethod::Nonlinear && r.nonlinear && !r.nonlinear->finished();
+  if (!r.dirty && !iterating) return;
   const auto t0 = Clock::now();
   // Blend: X_free = Φ_0 + Σ_j Φ_j [M_jᵀ; t_jᵀ].
   Eigen::MatrixXd coefficients(3 + 4 * r.handles, 3);
@@ -561,47 +760,40 @@ void Editor::Impl::update() {
   for (int j = 0; j < r.handles; ++j)
     coefficients.block<4, 3>(3 + 4 * j, 0) = r.transforms[static_cast<std::size_t>(j)].transpose();
   const int threads = options.threads;
-  blend_basis(r.basis, coefficients, r.free_vertices, r.current_base, threads);
+  blend_basis(r.basis, coefficients, r.free_vertices, r.frame, threads);
   for (int j = 0; j < r.handles; ++j) {
     const Transform& t = r.transforms[static_cast<std::size_t>(j)];
     for (const int v : r.handle_base[static_cast<std::size_t>(j)])
-      r.current_base.row(v) =
+      r.frame.row(v).head<3>() =
           (t.leftCols<3>() * base_rest.row(v).transpose() + t.col(3)).transpose();
   }
-  const auto t_normals = Clock::now();
   report.milliseconds["frame blend"] = ms_since(t0);
+  report.method = to_string(options.method);
+  if (options.method == EditMethod::Nonlinear) deform_base(r, r.dirty, budget_ms);
+  const auto t_normals = Clock::now();
   // Normals where they can change.
-  update_normals(topology, r.current_base, r.affected, r.current_normals, r.face_normals, threads);
+  update_normals(topology, r.affected, r.frame, r.face_normals, threads);
   const auto t_decode = Clock::now();
   report.milliseconds["frame normals"] = ms_since(t_normals);
-  // Decode.
-  parallel_for(r.encoded.size(), threads, [&](std::size_t e) {
-    const PhongDetail& d = r.details[e];
-    Eigen::Vector3d p;
-    switch (options.details) {
-    case DetailMode::Normal:
-      p = decode_phong(topology, r.current_base, r.current_normals, d);
-      break;
-    case DetailMode::Displacement:
-    case DetailMode::None: {
-      PhongDetail on_base = d;
-      on_base.offset = 0.0;
-      on_base.residual = false;
-      p = decode_phong(topology, r.current_base, r.current_normals, on_base);
-      if (options.details == DetailMode::Displacement) p += r.rest_offsets[e];
-      break;
-    }
-    }
-    r.current_positions.row(r.encoded[e]) = p.transpose();
-  });
+  decode_details(topology, r.frame, r.details, r.current_positions, threads);
   r.dirty = false;
   report.milliseconds["frame decode"] = ms_since(t_decode);
   report.milliseconds["frame"] = ms_since(t0);
 }
 
 const Eigen::MatrixXd& Editor::positions() {
-  impl_->update();
+  return positions(std::numeric_limits<double>::infinity());
+}
+
+const Eigen::MatrixXd& Editor::positions(double budget_ms) {
+  impl_->update(budget_ms);
   return impl_->region->current_positions;
+}
+
+bool Editor::converged() const {
+  const RegionState* r = impl_->region.get();
+  if (!r || impl_->options.method == EditMethod::Linear) return true;
+  return !r->dirty && r->nonlinear && r->nonlinear->finished();
 }
 
 Mesh Editor::result() {
@@ -620,8 +812,8 @@ const Mesh& Editor::base() const {
 }
 
 Eigen::MatrixXd Editor::base_positions() {
-  impl_->update();
-  return impl_->region->current_base;
+  impl_->update(std::numeric_limits<double>::infinity());
+  return impl_->region->frame.leftCols<3>();
 }
 
 Eigen::MatrixXd Editor::low_pass(const Eigen::MatrixXd& values) {
@@ -640,6 +832,13 @@ const EditReport& Editor::report() const {
 }
 const EditorOptions& Editor::options() const {
   return impl_->options;
+}
+
+EditorPartsView Editor::parts() const {
+  const Impl& m = *impl_;
+  return {m.input,          m.input_positions, m.input_topology, m.filter,        m.smooth,
+          m.base,           m.topology,        m.base_rest,      m.base_on_input, m.input_on_base,
+          m.negative_edges, m.statistics,      m.report};
 }
 
 nlohmann::json to_json(const EditReport& r) {
@@ -662,7 +861,8 @@ nlohmann::json to_json(const EditReport& r) {
                  {"free_base_vertices", r.free_base_vertices},
                  {"constrained_base_vertices", r.constrained_base_vertices},
                  {"handle_base_vertices", r.handle_base_vertices},
-                 {"negative_cotan_weights_in_support", r.negative_weights_in_support}};
+                 {"negative_cotan_weights_in_support", r.negative_weights_in_support},
+                 {"reused", r.region_reused}};
   j["solver"] = {{"name", r.solver},
                  {"solves", r.solves},
                  {"iterations", r.solver_stats.iterations},
@@ -673,6 +873,14 @@ nlohmann::json to_json(const EditReport& r) {
                 {"extrapolated", r.phong.extrapolated},
                 {"fallbacks", r.phong.fallbacks},
                 {"max_abs_offset", r.phong.max_abs_offset}};
+  j["method"] = r.method;
+  if (r.method == "nonlinear") {
+    const NonlinearStats& n = r.nonlinear;
+    j["nonlinear"] = {{"iterations", n.iterations},   {"total_iterations", n.total_iterations},
+                      {"accelerated", n.accelerated}, {"converged", n.converged},
+                      {"last_move", n.last_move},     {"energy", n.energy},
+                      {"fallback", r.fallback}};
+  }
   j["milliseconds"] = r.milliseconds;
   return j;
 }

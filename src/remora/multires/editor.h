@@ -28,8 +28,10 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <stop_token>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -39,7 +41,9 @@
 #include "remora/linalg/kharmonic.h"
 #include "remora/linalg/solver.h"
 #include "remora/mesh/mesh.h"
+#include "remora/multires/base_figures.h"
 #include "remora/multires/base_surface.h"
+#include "remora/multires/nonlinear.h"
 #include "remora/multires/phong.h"
 #include "remora/remesh/remesh.h"
 
@@ -79,11 +83,14 @@ struct EditorOptions {
   /// direct solver for a symmetric system, "lu" for the Mixed one.
   SolverOptions solver;
   DetailMode details = DetailMode::Normal;
+  EditMethod method = EditMethod::Linear;
+  NonlinearOptions nonlinear; ///< method Nonlinear: the energy and its iterations
   PhongOptions phong;
   int threads = 0; ///< 0 = all hardware threads
   /// The memory this editor may plan with (0 = no limit): set_region refuses (InvalidArgument) a
   /// region whose estimate (region_bytes() of multires/limits.h) added to the preprocessing's
-  /// (kEditorBytesPerTriangle per input triangle) exceeds it.
+  /// (kEditorBytesPerTriangle per input triangle) exceeds it, and keeps fewer regions for an
+  /// undo where they would not fit beside it.
   std::uint64_t memory_bytes = 0;
   /// Called at the start of every phase: (phase name, step, number of steps).
   std::function<void(std::string_view phase, int step, int steps)> progress;
@@ -109,10 +116,21 @@ struct EditReport {
   /// Edges of the system's mesh with a free end whose cotan weight is negative (none on a good
   /// remesh; many on a scan's own connectivity).
   std::size_t negative_weights_in_support = 0;
+  /// The region was one of the last ones installed, set again (an undo): installed as it was,
+  /// without the work; the other figures are those of its first set_region().
+  bool region_reused = false;
   std::string solver;
   SolverStats solver_stats;
   int solves = 0; ///< right-hand sides solved (3 + 4h)
   PhongStats phong;
+  /// The base's deformation in the last frame: "linear" or "nonlinear".
+  std::string method = "linear";
+  NonlinearStats nonlinear; ///< method nonlinear: the last frame's iterations
+  /// Method nonlinear: "coarse" when the last frame showed the preview of a large support,
+  /// "fine" otherwise (multires/nonlinear_region.h).
+  std::string nonlinear_level;
+  /// Method nonlinear: why the last frame shows the linear result instead (empty otherwise).
+  std::string fallback;
   /// Wall time in milliseconds: "base", "remesh", "set_region" (and its parts "assemble",
   /// "factor", "solve", "encode"), "frame" (the last positions() that had work to do).
   std::map<std::string, double> milliseconds;
@@ -120,11 +138,51 @@ struct EditReport {
 
 nlohmann::json to_json(const EditReport& report);
 
+/// The preprocessed pieces of an editor (steps 1-3), as a bake (multires/bake.h) hands them to
+/// a new editor: O, its low-pass S, the base B with both correspondences, and the base's figures.
+/// Shapes: input_positions and smooth n_input × 3, base_rest n_base × 3; base_on_input has a
+/// location on O per base vertex, input_on_base one on B per input vertex (invalid face for an
+/// isolated one).
+struct EditorParts {
+  Mesh input;
+  Eigen::MatrixXd input_positions; ///< O
+  TriangleTopology input_topology;
+  std::shared_ptr<const LowPassFilter> filter; ///< immutable, shared by the editors of a bake
+  Eigen::MatrixXd smooth;                      ///< S = filter(O)
+  Mesh base;
+  TriangleTopology topology;
+  Eigen::MatrixXd base_rest; ///< B
+  std::vector<SurfacePoint> base_on_input, input_on_base;
+  std::vector<std::pair<int, int>> negative_edges; ///< base edges with a negative cotan weight
+  BaseStatistics statistics; ///< per base vertex, what the report's figures sum
+  EditReport report;         ///< the base's figures
+};
+
+/// The same pieces of an existing editor, read-only (what a bake reads).
+struct EditorPartsView {
+  const Mesh& input;
+  const Eigen::MatrixXd& input_positions;
+  const TriangleTopology& input_topology;
+  const std::shared_ptr<const LowPassFilter>& filter;
+  const Eigen::MatrixXd& smooth;
+  const Mesh& base;
+  const TriangleTopology& topology;
+  const Eigen::MatrixXd& base_rest;
+  const std::vector<SurfacePoint>& base_on_input;
+  const std::vector<SurfacePoint>& input_on_base;
+  const std::vector<std::pair<int, int>>& negative_edges;
+  const BaseStatistics& statistics;
+  const EditReport& report;
+};
+
 class Editor {
 public:
   /// Steps 1-3. `mesh` must be a repaired mesh without deleted elements (read_mesh() gives one).
   /// Throws InvalidArgument for an empty mesh, non-finite points or bad options.
   explicit Editor(Mesh mesh, EditorOptions options = {});
+  /// Steps 1-3 adopted from a bake (multires/bake.h), nothing recomputed; `options` as they made
+  /// the pieces, remesh on. Throws InvalidArgument when the pieces' sizes disagree.
+  Editor(EditorParts parts, EditorOptions options);
   Editor(Editor&&) noexcept;
   Editor& operator=(Editor&&) noexcept;
   ~Editor();
@@ -134,9 +192,37 @@ public:
   /// identity. Throws InvalidArgument for an empty support, no handle, an empty handle, an id out
   /// of range, a handle vertex outside the support or in two handles, a support that maps to no
   /// free base vertex, a support component (on the base) with no constrained vertex, or a region
-  /// over options().memory_bytes (checked before the factorization); throws NumericalError
-  /// when the solver fails. On a throw the previous region stays in place.
-  void set_region(const std::vector<int>& support, const std::vector<std::vector<int>>& handles);
+  /// over options().memory_bytes (checked before the factorization); throws NumericalError when
+  /// the solver fails, and Cancelled when `stop` is triggered (checked between the steps; a
+  /// factorization runs to its end). On a throw the previous region and the report stay as they
+  /// were. One of the last two regions installed before this one, set again with the same ids
+  /// and system (an undo), is installed as it was, without the work: the same positions bit for
+  /// bit. Those kept regions are dropped, the oldest first, when a new region would not fit
+  /// beside them in options().memory_bytes.
+  void set_region(const std::vector<int>& support, const std::vector<std::vector<int>>& handles,
+                  const std::stop_token& stop = {});
+
+  /// set_region() in two halves: prepare_region() does the work (it may throw as set_region()
+  /// does) and changes nothing the editor shows; install_region() makes the prepared region the
+  /// current one, at no cost. A caller can thus drop a region that a newer request made stale.
+  /// install_region() throws InvalidArgument for a region another editor prepared, or one
+  /// installed already.
+  class Prepared {
+  public:
+    Prepared();
+    Prepared(Prepared&&) noexcept;
+    Prepared& operator=(Prepared&&) noexcept;
+    ~Prepared();
+    struct State;
+
+  private:
+    friend class Editor;
+    std::unique_ptr<State> state_;
+  };
+  Prepared prepare_region(const std::vector<int>& support,
+                          const std::vector<std::vector<int>>& handles,
+                          const std::stop_token& stop = {});
+  void install_region(Prepared&& prepared);
 
   int handle_count() const;
   /// The vertices of O that can move under the current region (the support, handles included),
@@ -145,6 +231,11 @@ public:
   /// Changes k and the area weights for the next set_region(). Throws InvalidArgument for a k
   /// other than 1, 2, 3, or weights the configured solver cannot take.
   void set_system(const KHarmonicOptions& system);
+  /// Switches the base's deformation, for the current region and the next ones. Cheap: the next
+  /// positions() call builds what nonlinear needs for the current region if set_region did not
+  /// (a factorization, as in set_region; a failure leaves the linear result with a message in
+  /// the report).
+  void set_method(EditMethod method);
   /// The centroid of handle j's vertices on O (the default center of rotations and scalings).
   Eigen::Vector3d handle_center(int handle) const;
 
@@ -156,8 +247,16 @@ public:
   const Transform& transform(int handle) const;
 
   /// Step 7: O's vertex positions under the current transforms (n_vertices × 3). Blends the basis
-  /// functions and decodes the details when a transform changed since the last call.
+  /// functions and decodes the details when a transform changed since the last call. Method
+  /// nonlinear: iterates until converged (or its max_iterations).
   const Eigen::MatrixXd& positions();
+  /// Method nonlinear while a handle is dragged: at most `budget_ms` of iterations (at least
+  /// one), continuing from the last call, then the decode; call again to go on towards
+  /// convergence. The same as positions() for method linear.
+  const Eigen::MatrixXd& positions(double budget_ms);
+  /// Whether positions() are final: true for method linear, and for nonlinear once the
+  /// iteration has converged, reached its max_iterations or fallen back to the linear result.
+  bool converged() const;
   /// O with positions(): same connectivity, bit-identical points outside the support.
   Mesh result();
 
@@ -173,6 +272,8 @@ public:
 
   const EditReport& report() const;
   const EditorOptions& options() const;
+  /// Steps 1-3's pieces, read-only (valid while the editor lives and is not moved from).
+  EditorPartsView parts() const;
 
 private:
   struct Impl;

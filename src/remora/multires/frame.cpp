@@ -5,13 +5,28 @@
 #include <cstddef>
 
 #include <Eigen/Geometry>
+#include <fmt/format.h>
 
+#include "remora/common/error.h"
 #include "remora/common/parallel.h"
+#include "remora/multires/phong_decode.h"
 
 namespace remora {
 
+FrameRows frame_rows(const Eigen::MatrixXd& positions, const Eigen::MatrixXd& normals) {
+  if (positions.cols() != 3 || normals.cols() != 3 || positions.rows() != normals.rows())
+    throw InvalidArgument(fmt::format("frame_rows: positions are {}×{} and normals {}×{}; give "
+                                      "two n×3 matrices",
+                                      positions.rows(), positions.cols(), normals.rows(),
+                                      normals.cols()));
+  FrameRows frame(positions.rows(), 6);
+  frame.leftCols<3>() = positions;
+  frame.rightCols<3>() = normals;
+  return frame;
+}
+
 void blend_basis(const BasisRows& basis, const Eigen::MatrixXd& coefficients,
-                 const std::vector<int>& free_vertices, RowPoints& positions, int threads) {
+                 const std::vector<int>& free_vertices, FrameRows& frame, int threads) {
   assert(basis.rows() == static_cast<Eigen::Index>(free_vertices.size()));
   assert(basis.cols() == coefficients.rows() && coefficients.cols() == 3);
   const Eigen::Index m = basis.cols();
@@ -23,10 +38,10 @@ void blend_basis(const BasisRows& basis, const Eigen::MatrixXd& coefficients,
       y += b[k] * coefficients(k, 1);
       z += b[k] * coefficients(k, 2);
     }
-    const int v = free_vertices[row];
-    positions(v, 0) = x;
-    positions(v, 1) = y;
-    positions(v, 2) = z;
+    double* out = frame.data() + 6 * static_cast<Eigen::Index>(free_vertices[row]);
+    out[0] = x;
+    out[1] = y;
+    out[2] = z;
   });
 }
 
@@ -52,16 +67,17 @@ NormalPlan plan_normals(const TriangleTopology& topology, const std::vector<int>
   return plan;
 }
 
-void update_normals(const TriangleTopology& topology, const RowPoints& positions,
-                    const NormalPlan& plan, RowPoints& normals, std::vector<double>& scratch,
-                    int threads) {
+void update_normals(const TriangleTopology& topology, const NormalPlan& plan, FrameRows& frame,
+                    std::vector<double>& scratch, int threads) {
   scratch.resize(3 * plan.faces.size());
+  const auto position = [&](int v) {
+    const double* p = frame.data() + 6 * static_cast<Eigen::Index>(v);
+    return Eigen::Vector3d(p[0], p[1], p[2]);
+  };
   parallel_for(plan.faces.size(), threads, [&](std::size_t i) {
     const auto& f = topology.faces[static_cast<std::size_t>(plan.faces[i])];
-    const Eigen::Vector3d p0 = positions.row(f[0]);
-    const Eigen::Vector3d p1 = positions.row(f[1]);
-    const Eigen::Vector3d p2 = positions.row(f[2]);
-    const Eigen::Vector3d n = (p1 - p0).cross(p2 - p0);
+    const Eigen::Vector3d p0 = position(f[0]);
+    const Eigen::Vector3d n = (position(f[1]) - p0).cross(position(f[2]) - p0);
     scratch[3 * i] = n[0];
     scratch[3 * i + 1] = n[1];
     scratch[3 * i + 2] = n[2];
@@ -73,8 +89,54 @@ void update_normals(const TriangleTopology& topology, const RowPoints& positions
       sum += Eigen::Vector3d(scratch[s], scratch[s + 1], scratch[s + 2]);
     }
     const double len = sum.norm();
-    normals.row(plan.vertices[i]) =
-        len > 0.0 ? Eigen::RowVector3d((sum / len).transpose()) : Eigen::RowVector3d::Zero();
+    const Eigen::Vector3d n = len > 0.0 ? Eigen::Vector3d(sum / len) : Eigen::Vector3d::Zero();
+    double* out = frame.data() + 6 * static_cast<Eigen::Index>(plan.vertices[i]) + 3;
+    out[0] = n[0];
+    out[1] = n[1];
+    out[2] = n[2];
+  });
+}
+
+FrameDetails frame_details(const std::vector<PhongDetail>& details, const std::vector<int>& outputs,
+                           bool keep_offsets, const std::vector<Eigen::Vector3d>& added) {
+  if (outputs.size() != details.size() || (!added.empty() && added.size() != details.size()))
+    throw InvalidArgument(fmt::format("frame_details: {} details, {} outputs, {} added offsets",
+                                      details.size(), outputs.size(), added.size()));
+  FrameDetails out;
+  out.outputs = outputs;
+  out.offsets = added;
+  out.records.reserve(details.size());
+  for (const PhongDetail& d : details) {
+    FrameDetails::Record r{d.base.bary, keep_offsets ? d.offset : 0.0, d.base.face.idx(), -1};
+    if (keep_offsets && d.residual) {
+      r.residual = static_cast<int>(out.residuals.size());
+      out.residuals.push_back(d.frame);
+    }
+    out.records.push_back(r);
+  }
+  return out;
+}
+
+void decode_details(const TriangleTopology& topology, const FrameRows& frame,
+                    const FrameDetails& details, Eigen::MatrixXd& positions, int threads) {
+  parallel_for(details.records.size(), threads, [&](std::size_t i) {
+    const FrameDetails::Record& r = details.records[i];
+    Eigen::Vector3d x[3], n[3];
+    const auto& f = topology.faces[static_cast<std::size_t>(r.face)];
+    for (int k = 0; k < 3; ++k) {
+      const double* row =
+          frame.data() + 6 * static_cast<Eigen::Index>(f[static_cast<std::size_t>(k)]);
+      x[k] = Eigen::Vector3d(row[0], row[1], row[2]);
+      n[k] = Eigen::Vector3d(row[3], row[4], row[5]);
+    }
+    Eigen::Vector3d p = phong_detail::phong_point(
+        x, n, r.bary, r.offset,
+        r.residual >= 0 ? &details.residuals[static_cast<std::size_t>(r.residual)] : nullptr);
+    if (!details.offsets.empty()) p += details.offsets[i];
+    const int v = details.outputs[i];
+    positions(v, 0) = p[0];
+    positions(v, 1) = p[1];
+    positions(v, 2) = p[2];
   });
 }
 

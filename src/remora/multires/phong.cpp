@@ -8,6 +8,7 @@
 
 #include "remora/common/error.h"
 #include "remora/common/parallel.h"
+#include "remora/multires/phong_decode.h"
 
 namespace remora {
 namespace {
@@ -34,34 +35,13 @@ Corners corners(const TriangleTopology& t, const Points& positions, const Points
   return c;
 }
 
-/// The face's frame: edge 0-1, normal × edge, normal. False for a face without area.
 bool face_frame(const Corners& c, V3& t1, V3& t2, V3& nf) {
-  const V3 e1 = c.x[1] - c.x[0];
-  const V3 cross = e1.cross(c.x[2] - c.x[0]);
-  const double len = e1.norm(), area2 = cross.norm();
-  if (!(area2 > 1e-14 * std::max(len * len, (c.x[2] - c.x[0]).squaredNorm())) || !(len > 0.0))
-    return false;
-  t1 = e1 / len;
-  nf = cross / area2;
-  t2 = nf.cross(t1);
-  return true;
+  return phong_detail::face_frame(c.x, t1, t2, nf);
 }
 
 V3 decode(const Corners& c, const PhongDetail& d) {
-  const auto& a = d.base.bary;
-  const V3 b = a[0] * c.x[0] + a[1] * c.x[1] + a[2] * c.x[2];
-  V3 n = a[0] * c.n[0] + a[1] * c.n[1] + a[2] * c.n[2];
-  const double len = n.norm();
-  V3 p = b;
-  if (len > 0.0) p += (d.offset / len) * n;
-  if (d.residual) {
-    V3 t1, t2, nf;
-    if (face_frame(c, t1, t2, nf))
-      p += d.frame[0] * t1 + d.frame[1] * t2 + d.frame[2] * nf;
-    else
-      p += V3(d.frame[0], d.frame[1], d.frame[2]);
-  }
-  return p;
+  return phong_detail::phong_point(c.x, c.n, d.base.bary, d.offset,
+                                   d.residual ? &d.frame : nullptr);
 }
 
 struct FaceSolution {
@@ -105,14 +85,15 @@ FaceSolution solve_in_face(const Corners& c, const V3& p) {
       s.offset = lambda * len;
       return s;
     }
-    Eigen::Matrix3d j;
-    j.col(0) = e1 + lambda * f1;
-    j.col(1) = e2 + lambda * f2;
-    j.col(2) = n;
-    const double jdet = j.determinant();
-    if (!(std::abs(jdet) > 1e-12 * j.col(0).norm() * j.col(1).norm() * j.col(2).norm()))
+    // The Jacobian's columns, and its solve by Cramer's rule (3 × 3, guarded against the
+    // focal surface where it becomes singular).
+    const V3 c0 = e1 + lambda * f1, c1 = e2 + lambda * f2, c2 = n;
+    const V3 c12 = c1.cross(c2);
+    const double jdet = c0.dot(c12);
+    if (!(std::abs(jdet) > 1e-12 * c0.norm() * c1.norm() * c2.norm()))
       return s; // on the focal surface
-    const V3 step = j.partialPivLu().solve(-residual);
+    const V3 b = -residual;
+    const V3 step(b.dot(c12) / jdet, c0.dot(b.cross(c2)) / jdet, c0.dot(c1.cross(b)) / jdet);
     u += step[0];
     v += step[1];
     lambda += step[2];
@@ -146,26 +127,59 @@ struct Outcome {
   bool extrapolated = false, fallback = false;
 };
 
+/// The face reached from `start` by walking towards p's orthogonal projection: across the edge of
+/// the most negative barycentric coordinate (on the face's plane) until none is negative, the
+/// boundary or the face just left is met, or `max_steps` moves were made. Cheap (no Newton), it
+/// brings the Phong search close to its face when the base has moved far from where the start
+/// face was found. `steps` counts the moves.
+int approach(const TriangleTopology& t, const Eigen::MatrixXd& positions, const V3& p, int start,
+             int max_steps, std::size_t& steps) {
+  int face = start, previous = -1;
+  for (int step = 0; step < max_steps; ++step) {
+    const auto& f = t.faces[static_cast<std::size_t>(face)];
+    const V3 a = positions.row(f[0]), e1 = V3(positions.row(f[1])) - a,
+             e2 = V3(positions.row(f[2])) - a, d = p - a;
+    const double g11 = e1.dot(e1), g12 = e1.dot(e2), g22 = e2.dot(e2);
+    const double det = g11 * g22 - g12 * g12;
+    if (!(det > 1e-24 * g11 * g22)) break;
+    const double u = (g22 * d.dot(e1) - g12 * d.dot(e2)) / det;
+    const double v = (g11 * d.dot(e2) - g12 * d.dot(e1)) / det;
+    const double bary[3] = {1.0 - u - v, u, v};
+    const int k = bary[0] <= bary[1] && bary[0] <= bary[2] ? 0 : (bary[1] <= bary[2] ? 1 : 2);
+    if (bary[k] >= -kInside) break;
+    const int next = t.across[static_cast<std::size_t>(face)][static_cast<std::size_t>(k)];
+    if (next < 0 || next == previous) break;
+    previous = face;
+    face = next;
+    ++steps;
+  }
+  return face;
+}
+
 Outcome encode_one(const TriangleTopology& t, const Eigen::MatrixXd& positions,
                    const Eigen::MatrixXd& normals, const V3& p, int start,
                    const PhongOptions& options) {
   Outcome out;
+  start = approach(t, positions, p, start, options.max_walk_steps, out.steps);
   int face = start;
   int best_face = -1;
   FaceSolution best;
-  std::vector<int> visited;
+  // The faces visited (a walk never returns to one); reused by the calls on this thread.
+  thread_local std::vector<int> visited;
+  visited.clear();
   bool accepted = false;
   // Newton may fail in the start face (p beyond its focal point) and succeed next door: try the
   // faces around the start before giving up.
-  std::vector<int> seeds{start};
+  std::array<int, 4> seeds{start, -1, -1, -1};
+  std::size_t seed_count = 1;
   for (const int g : t.across[static_cast<std::size_t>(start)])
-    if (g >= 0) seeds.push_back(g);
+    if (g >= 0) seeds[seed_count++] = g;
   std::size_t seed = 0;
   for (int step = 0; step <= options.max_walk_steps; ++step) {
     const Corners c = corners(t, positions, normals, face);
     const FaceSolution s = solve_in_face(c, p);
     if (!s.ok) {
-      if (best_face >= 0 || ++seed >= seeds.size()) break;
+      if (best_face >= 0 || ++seed >= seed_count) break;
       face = seeds[seed];
       continue;
     }
@@ -256,6 +270,24 @@ TriangleTopology triangle_topology(const Mesh& mesh) {
   return t;
 }
 
+namespace {
+
+/// The normal of vertex v: the normalized sum of its faces' cross products, (0, 0, 0) where it
+/// vanishes.
+Eigen::RowVector3d vertex_normal(const TriangleTopology& t, const Eigen::MatrixXd& positions,
+                                 std::size_t v) {
+  V3 sum = V3::Zero();
+  for (int k = t.vertex_offsets[v]; k < t.vertex_offsets[v + 1]; ++k) {
+    const auto& f = t.faces[static_cast<std::size_t>(t.vertex_faces[static_cast<std::size_t>(k)])];
+    const V3 a = positions.row(f[0]), b = positions.row(f[1]), c = positions.row(f[2]);
+    sum += (b - a).cross(c - a);
+  }
+  const double len = sum.norm();
+  return len > 0.0 ? Eigen::RowVector3d((sum / len).transpose()) : Eigen::RowVector3d::Zero();
+}
+
+} // namespace
+
 Eigen::MatrixXd vertex_normals(const TriangleTopology& t, const Eigen::MatrixXd& positions) {
   const auto nv = static_cast<Eigen::Index>(t.vertex_offsets.size()) - 1;
   if (positions.rows() != nv || positions.cols() != 3)
@@ -263,18 +295,25 @@ Eigen::MatrixXd vertex_normals(const TriangleTopology& t, const Eigen::MatrixXd&
                                       positions.rows(), positions.cols(), nv));
   Eigen::MatrixXd normals(nv, 3);
   parallel_for(static_cast<std::size_t>(nv), 0, [&](std::size_t v) {
-    V3 sum = V3::Zero();
-    for (int k = t.vertex_offsets[v]; k < t.vertex_offsets[v + 1]; ++k) {
-      const auto& f =
-          t.faces[static_cast<std::size_t>(t.vertex_faces[static_cast<std::size_t>(k)])];
-      const V3 a = positions.row(f[0]), b = positions.row(f[1]), c = positions.row(f[2]);
-      sum += (b - a).cross(c - a);
-    }
-    const double len = sum.norm();
-    normals.row(static_cast<Eigen::Index>(v)) =
-        len > 0.0 ? Eigen::RowVector3d((sum / len).transpose()) : Eigen::RowVector3d::Zero();
+    normals.row(static_cast<Eigen::Index>(v)) = vertex_normal(t, positions, v);
   });
   return normals;
+}
+
+void update_vertex_normals(const TriangleTopology& t, const Eigen::MatrixXd& positions,
+                           const std::vector<int>& vertices, Eigen::MatrixXd& normals,
+                           int threads) {
+  const auto nv = static_cast<Eigen::Index>(t.vertex_offsets.size()) - 1;
+  if (positions.rows() != nv || positions.cols() != 3 || normals.rows() != nv ||
+      normals.cols() != 3)
+    throw InvalidArgument(fmt::format("update_vertex_normals: positions are {}×{} and normals "
+                                      "{}×{}, expected {}×3",
+                                      positions.rows(), positions.cols(), normals.rows(),
+                                      normals.cols(), nv));
+  parallel_for(vertices.size(), threads, [&](std::size_t i) {
+    const auto v = static_cast<std::size_t>(vertices[i]);
+    normals.row(static_cast<Eigen::Index>(v)) = vertex_normal(t, positions, v);
+  });
 }
 
 std::vector<PhongDetail> encode_phong(const TriangleTopology& topology,

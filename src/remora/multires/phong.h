@@ -44,6 +44,12 @@ TriangleTopology triangle_topology(const Mesh& mesh);
 /// Unit vertex normals (n_vertices × 3): the sum of the incident faces' cross products (area
 /// weighted), normalized; (0, 0, 0) for a vertex whose faces all have zero area.
 Eigen::MatrixXd vertex_normals(const TriangleTopology& topology, const Eigen::MatrixXd& positions);
+/// The rows `vertices` of normals (n_vertices × 3) made what vertex_normals() gives for them, bit
+/// for bit; the other rows are left alone. Parallel with `threads` threads (0 = all). Throws
+/// InvalidArgument for wrong shapes.
+void update_vertex_normals(const TriangleTopology& topology, const Eigen::MatrixXd& positions,
+                           const std::vector<int>& vertices, Eigen::MatrixXd& normals,
+                           int threads = 0);
 
 struct PhongDetail {
   SurfacePoint base;     ///< on the base mesh; coordinates may be slightly outside the face

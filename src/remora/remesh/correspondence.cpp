@@ -218,6 +218,19 @@ void init_points(Remesher& rm) {
   }
 }
 
+// Input vertex i starts at located[i] on the working mesh, or is not tracked (invalid face).
+void init_points(Remesher& rm, const std::vector<SurfacePoint>& located) {
+  const std::size_t n = located.size();
+  rm.track.assign(n, SurfacePoint());
+  rm.next.assign(n, -1);
+  rm.prev.assign(n, -1);
+  for (std::size_t i = 0; i < n; ++i) {
+    if (!located[i].face.is_valid()) continue;
+    link_point(rm, static_cast<int>(i), located[i].face);
+    rm.track[i].bary = located[i].bary;
+  }
+}
+
 // Takes every input vertex off face f and appends it to `out`.
 void take_points(Remesher& rm, FaceHandle f, std::vector<int>& out) {
   PointList& list = rm.points(f);

@@ -183,7 +183,8 @@ struct Areas {
   double target = 0;
 };
 
-// Fills `areas`; false when the mesh has no interior vertex.
+// Fills `areas`; false when the mesh has no interior vertex. A patch's locked vertices count
+// their area outside it too, and a patch aims at the whole mesh's mean area (patch.cpp).
 bool measure_areas(const Remesher& rm, bool guard, Areas& areas) {
   const std::size_t nf = rm.mesh.n_faces();
   std::vector<std::array<double, 4>>& face_parts = areas.face_parts;
@@ -203,6 +204,15 @@ bool measure_areas(const Remesher& rm, bool guard, Areas& areas) {
     if (rm.mesh.status(f).deleted()) continue;
     const auto fv = face_vertices(rm.mesh, f);
     for (int c = 0; c < 3; ++c) area[static_cast<std::size_t>(fv[c].idx())] += face_parts[i][c];
+  }
+  if (!rm.outside_area.empty())
+    for (auto v : rm.mesh.vertices())
+      if (rm.origin(v) >= 0)
+        area[static_cast<std::size_t>(v.idx())] +=
+            rm.outside_area[static_cast<std::size_t>(rm.origin(v))];
+  if (rm.target_area > 0) {
+    areas.target = rm.target_area;
+    return true;
   }
   double sum = 0;
   std::size_t count = 0;

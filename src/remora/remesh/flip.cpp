@@ -31,14 +31,20 @@ bool violates_delaunay(const Remesher& rm, EdgeHandle e) {
 } // namespace
 
 // One pass of valence-improving flips over all edges. Valences and targets (6 inside, 4 on
-// the boundary) are cached per vertex and updated by each flip.
+// the boundary, a patch's locked vertices less their edges outside it) are cached per vertex and
+// updated by each flip.
 std::size_t equalize_valences(Remesher& rm) {
   const std::size_t nv = rm.mesh.n_vertices();
   std::vector<int> excess(nv, 0); // valence minus target valence
   parallel_for(nv, rm.options.threads, [&](std::size_t i) {
     const VertexHandle v(static_cast<int>(i));
     if (rm.mesh.status(v).deleted()) return;
-    excess[i] = static_cast<int>(rm.mesh.valence(v)) - (rm.mesh.is_boundary(v) ? 4 : 6);
+    // A patch's locked vertex has edges outside the patch too (patch.cpp).
+    const int origin = rm.origin(v);
+    const int target = origin >= 0 && !rm.valence_target.empty()
+                           ? rm.valence_target[static_cast<std::size_t>(origin)]
+                           : (rm.mesh.is_boundary(v) ? 4 : 6);
+    excess[i] = static_cast<int>(rm.mesh.valence(v)) - target;
   });
   std::size_t count = 0;
   const std::size_t n = rm.mesh.n_edges();

@@ -11,9 +11,7 @@
 
 namespace remora {
 
-namespace {
-
-using namespace remesh_detail;
+namespace remesh_detail {
 
 void check_options(const Mesh& input, const RemeshOptions& options) {
   if (input.n_faces() == 0) throw InvalidArgument("remesh: the input mesh has no faces");
@@ -44,6 +42,12 @@ void check_options(const Mesh& input, const RemeshOptions& options) {
     throw InvalidArgument("remesh: boundary_spacing must be at most 4/3 (longer boundary edges "
                           "are split again; <= 1 turns the spacing off)");
 }
+
+} // namespace remesh_detail
+
+namespace {
+
+using namespace remesh_detail;
 
 // Runs f and adds its wall time to the phase's entry of the report.
 template <class F>
@@ -101,14 +105,27 @@ RemeshResult run(const Mesh& input, const RemeshOptions& options) {
   Remesher rm(input, options);
   report.length_from_area = rm.length_from_area;
   report.target_length = rm.length;
-  const bool figures = options.compute_report;
-  if (figures) timed(report, "report", [&] { report_input(rm, report); });
+  if (options.compute_report) timed(report, "report", [&] { report_input(rm, report); });
 
   find_curves(rm);
   init_locations(rm);
   mark_corners(rm);
   report.feature_edges = rm.feature_count;
   init_points(rm);
+  run_steps(rm, report);
+  finish_correspondence(rm, result.output_on_input, result.input_on_output, report);
+  rm.take_mesh(result.mesh);
+  report.milliseconds["total"] = ms_since(t_total);
+  return result;
+}
+
+} // namespace
+
+namespace remesh_detail {
+
+void run_steps(Remesher& rm, RemeshReport& report) {
+  const RemeshOptions& options = rm.options;
+  const bool figures = options.compute_report;
   run_cycles(rm, report);
   timed(report, "reorder", [&] { compact(rm); });
   timed(report, "repair",
@@ -118,20 +135,21 @@ RemeshResult run(const Mesh& input, const RemeshOptions& options) {
   timed(report, "equalize", [&] { fine_tune(rm, report); });
   timed(report, "reorder", [&] { remove_deleted(rm); });
   if (figures) timed(report, "report", [&] { report_output(rm, report); });
-
-  timed(report, "correspondence", [&] {
-    rm.progress("correspondence", 0, 1);
-    result.output_on_input.resize(rm.mesh.n_vertices());
-    for (auto v : rm.mesh.vertices()) result.output_on_input[v.idx()] = rm.loc(v);
-    reproject_points(rm); // the repair changed faces after the last moves
-    result.input_on_output = closest_input_locations(rm, report);
-  });
-  rm.take_mesh(result.mesh);
-  report.milliseconds["total"] = ms_since(t_total);
-  return result;
 }
 
-} // namespace
+void finish_correspondence(Remesher& rm, std::vector<SurfacePoint>& output_on_input,
+                           std::vector<SurfacePoint>& input_on_output, RemeshReport& report) {
+  timed(report, "correspondence", [&] {
+    rm.progress("correspondence", 0, 1);
+    output_on_input.resize(rm.mesh.n_vertices());
+    for (auto v : rm.mesh.vertices())
+      output_on_input[static_cast<std::size_t>(v.idx())] = rm.loc(v);
+    reproject_points(rm); // the repair changed faces after the last moves
+    input_on_output = closest_input_locations(rm, report);
+  });
+}
+
+} // namespace remesh_detail
 
 RemeshResult remesh(const Mesh& input, const RemeshOptions& options) {
   check_options(input, options);

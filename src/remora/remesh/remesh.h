@@ -174,4 +174,45 @@ RemeshResult remesh(const Mesh& input, const RemeshOptions& options = {});
 
 nlohmann::json to_json(const RemeshReport& report);
 
+/// A patch of an earlier remesh to remesh again where the surface under it changed (the
+/// editor's local bake, multires/bake.h), so that it fits back into the hole it came from. Its
+/// boundary is locked: boundary vertices never move or go, boundary edges are never split,
+/// flipped or collapsed. The locked vertices have faces outside the patch too: their mixed area
+/// and valence there make the fine-tuning's residuals and the valence flips those of the whole
+/// mesh. The fine-tuning aims at `target_area`, the whole mesh's mean vertex area.
+struct RemeshPatch {
+  Mesh mesh; ///< the starting triangulation: manifold, with a boundary
+  /// Per vertex of `mesh`: where it lies on the reference surface.
+  std::vector<SurfacePoint> on_reference;
+  /// Per reference vertex: where it lies on `mesh` (tracked through the remesh), or an invalid
+  /// face (not tracked).
+  std::vector<SurfacePoint> reference_on_mesh;
+  /// Per vertex of `mesh`, read for the boundary ones: the mixed area of its faces outside the
+  /// patch, and the valence in the patch at which its valence in the whole mesh is the ideal
+  /// one (6 inside, 4 on the whole mesh's boundary, less its edges outside the patch).
+  std::vector<double> outside_area;
+  std::vector<int> valence_target;
+  double target_area = 0.0; ///< > 0
+};
+
+struct RemeshPatchResult {
+  Mesh mesh;
+  /// Per output vertex: its index in the patch's mesh for a locked (boundary) vertex, else -1.
+  std::vector<int> origin;
+  std::vector<SurfacePoint> output_on_reference; ///< per output vertex
+  /// Per reference vertex tracked (a valid face in reference_on_mesh): its closest point on the
+  /// output; an invalid face for the others.
+  std::vector<SurfacePoint> reference_on_output;
+  RemeshReport report; ///< counts and timings (no figures)
+};
+
+/// Remeshes `patch` on `reference` (the surface it must lie on, e.g. the part of a smoothed
+/// input under it and a margin) with the steps of remesh() and options.target_length, which must
+/// be > 0 (the whole mesh's l). The boundary spacing and feature lines do not apply
+/// (boundary_spacing is ignored; feature_angle_deg must be 0). Throws InvalidArgument for a
+/// patch without boundary, mismatched sizes, a location outside the reference or the mesh, a
+/// target length or area that is not positive, and what remesh() throws for its options.
+RemeshPatchResult remesh_patch(const Mesh& reference, const RemeshPatch& patch,
+                               const RemeshOptions& options);
+
 } // namespace remora

@@ -12,6 +12,16 @@ namespace remora::remesh_detail {
 Remesher::Remesher(const Mesh& input_mesh, const RemeshOptions& remesh_options)
     : input(input_mesh), options(remesh_options), mesh(input_mesh) {
   add_properties();
+  set_lengths();
+}
+
+Remesher::Remesher(const Mesh& input_mesh, const Mesh& working, const RemeshOptions& remesh_options)
+    : input(input_mesh), options(remesh_options), mesh(working) {
+  add_properties();
+  set_lengths();
+}
+
+void Remesher::set_lengths() {
   const LengthScale scale = length_scale(input);
   length = options.target_length > 0 ? options.target_length : options.length_factor * scale.length;
   length_from_area = options.target_length <= 0 && scale.needles;

@@ -45,6 +45,7 @@ enum class Kind : std::uint8_t {
 struct VertexState {
   SurfacePoint loc;
   HalfedgeHandle curve_loc;
+  int origin = -1; ///< a patch's locked vertex: its index in the patch given (patch.cpp)
   Kind kind = Kind::Interior;
 };
 
@@ -64,6 +65,9 @@ public:
   /// Copies `input`; l from options (target_length, or length_factor × length_scale()).
   /// Throws InvalidArgument when l is not positive and finite.
   Remesher(const Mesh& input, const RemeshOptions& options);
+  /// A patch (patch.cpp): `working` is the starting working mesh, `input` the surface its
+  /// vertices lie on; the locations and kinds are the caller's to set.
+  Remesher(const Mesh& input, const Mesh& working, const RemeshOptions& options);
 
   /// Replaces the working mesh by `renumbered`, a copy made by copy_in_order() (order.cpp), and
   /// carries every element's state along `order` (new index -> old index).
@@ -86,6 +90,8 @@ public:
   }
   Kind& kind(VertexHandle v) { return mesh.property(vertex_state_, v).kind; }
   Kind kind(VertexHandle v) const { return mesh.property(vertex_state_, v).kind; }
+  int& origin(VertexHandle v) { return mesh.property(vertex_state_, v).origin; }
+  int origin(VertexHandle v) const { return mesh.property(vertex_state_, v).origin; }
   /// Does the edge lie on a feature line of the input?
   char& feature(EdgeHandle e) { return mesh.property(feature_, e); }
   char feature(EdgeHandle e) const { return mesh.property(feature_, e); }
@@ -118,12 +124,33 @@ public:
   std::vector<Vec3> previous_points; ///< positions at the start of the last iteration (momentum)
   std::size_t guarded = 0;           ///< moves the guard halved or dropped
 
+  // A patch (patch.cpp): its boundary stays as it is (no boundary edge is split); its locked
+  // vertices' mixed area and valence outside the patch, by origin(); the mean area the
+  // fine-tuning aims at (0: the mean of the interior vertices' areas).
+  bool locked_boundary = false;
+  std::vector<double> outside_area;
+  std::vector<int> valence_target;
+  double target_area = 0;
+
 private:
   void add_properties();
+  void set_lengths();
   OpenMesh::VPropHandleT<VertexState> vertex_state_;
   OpenMesh::EPropHandleT<char> feature_;
   OpenMesh::FPropHandleT<PointList> points_;
 };
+
+// --- remesh.cpp --------------------------------------------------------------------------------
+
+/// Throws InvalidArgument for an empty input or an option outside its range (remesh.h).
+void check_options(const Mesh& input, const RemeshOptions& options);
+/// §4 on a set-up Remesher (curves, kinds, locations and tracked points in place): the cycles,
+/// the repair, the fine-tuning and the final compaction, with the report's figures when asked.
+void run_steps(Remesher& rm, RemeshReport& report);
+/// The correspondence at the end: every output vertex's location on the input, and every
+/// tracked input vertex's closest point on the output.
+void finish_correspondence(Remesher& rm, std::vector<SurfacePoint>& output_on_input,
+                           std::vector<SurfacePoint>& input_on_output, RemeshReport& report);
 
 // --- curves.cpp: boundary and feature lines, corners, boundary spacing -------------------------
 
@@ -209,6 +236,8 @@ void init_locations(Remesher& rm);
 Vec3 relocate(Remesher& rm, VertexHandle v, const Vec3& p, VertexHandle near);
 /// Every input vertex starts on a face of its own output vertex.
 void init_points(Remesher& rm);
+/// Input vertex i starts at located[i] on the working mesh (not tracked: an invalid face).
+void init_points(Remesher& rm, const std::vector<SurfacePoint>& located);
 /// Takes every input vertex off face f and appends it to `out`.
 void take_points(Remesher& rm, FaceHandle f, std::vector<int>& out);
 /// Puts each input vertex of `taken` on the closest face around v; clears `taken`.

@@ -45,6 +45,7 @@ std::size_t split_long_edges(Remesher& rm) {
         continue;
       }
       const bool on_boundary = rm.mesh.is_boundary(e);
+      if (on_boundary && rm.locked_boundary) continue; // a patch's border stays as it is
       const bool on_feature = rm.feature(e);
       const VertexHandle v = rm.mesh.split(e, (pa + pb) * 0.5);
       rm.live_faces += on_boundary ? 1 : 2;

@@ -1,0 +1,204 @@
+// bake(): the order of the local bake's steps (bake.h), the filter's band, the base's moved
+// vertices, and the fallback to the full preprocess.
+#include "remora/multires/bake.h"
+
+#include <cmath>
+#include <ctime>
+#include <functional>
+#include <queue>
+#include <utility>
+
+#include <fmt/format.h>
+
+#include "remora/common/timer.h"
+#include "remora/multires/bake_steps.h"
+
+namespace remora {
+
+namespace bake_detail {
+namespace {
+
+// The input vertices whose point the edit changed (any coordinate, bitwise).
+std::vector<int> changed_vertices(const Eigen::MatrixXd& before, const Eigen::MatrixXd& after) {
+  std::vector<int> changed;
+  for (Eigen::Index i = 0; i < before.rows(); ++i)
+    if (before(i, 0) != after(i, 0) || before(i, 1) != after(i, 1) || before(i, 2) != after(i, 2))
+      changed.push_back(static_cast<int>(i));
+  return changed;
+}
+
+// Every vertex within `reach` of a source along the edges of the mesh (`points`), sorted:
+// Dijkstra from all sources at once, over the faces around each vertex.
+std::vector<int> grow_band(const TriangleTopology& t, const Eigen::MatrixXd& points,
+                           const std::vector<int>& sources, double reach) {
+  std::vector<double> distance(static_cast<std::size_t>(points.rows()),
+                               std::numeric_limits<double>::infinity());
+  using Entry = std::pair<double, int>;
+  std::priority_queue<Entry, std::vector<Entry>, std::greater<>> queue;
+  for (const int s : sources) {
+    distance[static_cast<std::size_t>(s)] = 0.0;
+    queue.emplace(0.0, s);
+  }
+  std::vector<int> band;
+  while (!queue.empty()) {
+    const auto [d, v] = queue.top();
+    queue.pop();
+    if (d > distance[static_cast<std::size_t>(v)]) continue;
+    band.push_back(v);
+    const auto vs = static_cast<std::size_t>(v);
+    for (int k = t.vertex_offsets[vs]; k < t.vertex_offsets[vs + 1]; ++k)
+      for (const int w :
+           t.faces[static_cast<std::size_t>(t.vertex_faces[static_cast<std::size_t>(k)])]) {
+        const double dw = d + (points.row(w) - points.row(v)).norm();
+        if (dw <= reach && dw < distance[static_cast<std::size_t>(w)]) {
+          distance[static_cast<std::size_t>(w)] = dw;
+          queue.emplace(dw, w);
+        }
+      }
+  }
+  std::sort(band.begin(), band.end());
+  return band;
+}
+
+// S' = S + F(O' − O), F solved on the band of settings.margin σ around the changed vertices.
+void filter_band(Bake& b) {
+  const auto n = static_cast<std::size_t>(b.input_positions.rows());
+  b.in_band.assign(n, 0);
+  b.smooth = b.old.smooth;
+  const std::vector<int> changed = changed_vertices(b.old.input_positions, b.input_positions);
+  b.report.changed_vertices = changed.size();
+  if (changed.empty()) return;
+  const double reach = b.settings.margin * b.old.filter->stats().sigma;
+  const std::vector<int> band = grow_band(b.old.input_topology, b.input_positions, changed, reach);
+  b.report.band_vertices = band.size();
+  if (static_cast<double>(band.size()) > b.settings.max_fraction * static_cast<double>(n))
+    throw NotLocal(
+        fmt::format("the edit's band holds {} of the {} input vertices", band.size(), n));
+  Eigen::MatrixXd change(static_cast<Eigen::Index>(band.size()), 3);
+  for (std::size_t r = 0; r < band.size(); ++r)
+    change.row(static_cast<Eigen::Index>(r)) =
+        b.input_positions.row(band[r]) - b.old.input_positions.row(band[r]);
+  const Eigen::MatrixXd smoothed = b.old.filter->apply_local(band, change);
+  for (std::size_t r = 0; r < band.size(); ++r) {
+    b.smooth.row(band[r]) += smoothed.row(static_cast<Eigen::Index>(r));
+    b.in_band[static_cast<std::size_t>(band[r])] = 1;
+  }
+}
+
+// B': every base vertex located on a face with a corner in the band goes to S' there.
+void move_base(Bake& b) {
+  const auto nb = static_cast<std::size_t>(b.old.base_rest.rows());
+  b.base_points = b.old.base_rest;
+  b.moved.assign(nb, 0);
+  for (std::size_t v = 0; v < nb; ++v) {
+    const SurfacePoint& sp = b.old.base_on_input[v];
+    const auto& f = b.old.input_topology.faces[static_cast<std::size_t>(sp.face.idx())];
+    if (!b.in_band[static_cast<std::size_t>(f[0])] && !b.in_band[static_cast<std::size_t>(f[1])] &&
+        !b.in_band[static_cast<std::size_t>(f[2])])
+      continue;
+    b.base_points.row(static_cast<Eigen::Index>(v)) = sp.bary[0] * b.smooth.row(f[0]) +
+                                                      sp.bary[1] * b.smooth.row(f[1]) +
+                                                      sp.bary[2] * b.smooth.row(f[2]);
+    b.moved[v] = 1;
+    ++b.report.moved_base_vertices;
+  }
+}
+
+// The process's CPU time in milliseconds.
+double cpu_ms() {
+  timespec t{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return 1e3 * static_cast<double>(t.tv_sec) + 1e-6 * static_cast<double>(t.tv_nsec);
+}
+
+// Runs f, adding its wall and CPU time to the report's part.
+template <class F>
+auto timed(BakeReport& report, const char* part, F&& f) {
+  struct Stop {
+    BakeReport& report;
+    const char* part;
+    Clock::time_point t0 = Clock::now();
+    double cpu0 = cpu_ms();
+    ~Stop() {
+      report.milliseconds[part] += ms_since(t0);
+      report.cpu_milliseconds[part] += cpu_ms() - cpu0;
+    }
+  } stop{report, part};
+  return f();
+}
+
+// Steps 1-3 of bake.h; throws NotLocal (or what a step throws) where they cannot work.
+EditorParts local_parts(const Editor& editor, const Eigen::MatrixXd& positions,
+                        const BakeOptions& settings, BakeReport& report) {
+  const EditorOptions& options = editor.options();
+  Bake b{editor.parts(), options, settings, report, positions, {}, {}, {}, {}, {}};
+  auto progress = [&](int step) {
+    if (options.progress) options.progress("bake", step, 4);
+  };
+  progress(0);
+  timed(report, "filter", [&] { filter_band(b); });
+  timed(report, "base", [&] { move_base(b); });
+  progress(1);
+  SpliceMap map;
+  const bool has_patch = timed(report, "patch", [&] { return select_patch(b); });
+  if (!has_patch) {
+    EditorParts parts = timed(report, "stitch", [&] { return stitch(b, nullptr, nullptr, map); });
+    timed(report, "report", [&] { base_figures(b, parts, nullptr); });
+    return parts;
+  }
+  const PatchMeshes meshes = timed(report, "patch", [&] { return patch_meshes(b); });
+  progress(2);
+  RemeshOptions ro = options.remesh_options;
+  ro.target_length = b.old.report.base_target_length;
+  ro.threads = options.threads;
+  ro.compute_report = false;
+  ro.cycles = settings.cycles;
+  ro.equalize_iterations = settings.equalize_iterations;
+  ro.progress = nullptr;
+  const RemeshPatchResult remeshed =
+      timed(report, "remesh", [&] { return remesh_patch(meshes.reference, meshes.patch, ro); });
+  report.patch_faces_after = remeshed.mesh.n_faces();
+  progress(3);
+  EditorParts parts = timed(report, "stitch", [&] { return stitch(b, &meshes, &remeshed, map); });
+  timed(report, "report", [&] { base_figures(b, parts, &map); });
+  return parts;
+}
+
+} // namespace
+} // namespace bake_detail
+
+BakeResult bake(Editor& editor, const BakeOptions& options) {
+  const auto t0 = Clock::now();
+  const Eigen::MatrixXd& positions = editor.positions();
+  BakeReport report;
+  std::string reason;
+  if (options.force_full)
+    reason = "asked for";
+  else if (!editor.options().remesh)
+    reason = "the base is the input itself (no remesh)";
+  else if (editor.options().remesh_options.feature_angle_deg > 0)
+    reason = "the base keeps feature lines";
+  if (reason.empty()) {
+    try {
+      const double cpu0 = bake_detail::cpu_ms();
+      EditorParts parts = bake_detail::local_parts(editor, positions, options, report);
+      report.cpu_milliseconds["total"] = bake_detail::cpu_ms() - cpu0;
+      Editor baked(std::move(parts), editor.options());
+      report.local = true;
+      report.milliseconds["total"] = ms_since(t0);
+      return {std::move(baked), std::move(report)};
+    } catch (const bake_detail::NotLocal& e) {
+      reason = e.what();
+    } catch (const Error& e) {
+      reason = fmt::format("the local bake failed: {}", e.what());
+    }
+  }
+  BakeReport full;
+  full.fallback = reason;
+  full.changed_vertices = report.changed_vertices;
+  Editor baked(editor.result(), editor.options());
+  full.milliseconds["total"] = ms_since(t0);
+  return {std::move(baked), std::move(full)};
+}
+
+} // namespace remora

@@ -1,0 +1,610 @@
+#include "remora/multires/nonlinear.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+
+#include <Eigen/Dense>
+#include <Eigen/Geometry>
+#include <Eigen/SVD>
+#include <fmt/format.h>
+
+#include "remora/common/error.h"
+#include "remora/common/parallel.h"
+#include "remora/common/timer.h"
+#include "remora/geometry/laplacian.h"
+#include "remora/geometry/measures.h"
+
+namespace remora {
+
+namespace {
+
+using Matrix3 = Eigen::Matrix3d;
+using Vector3 = Eigen::Vector3d;
+
+/// The rotation R maximizing tr(R P) by SVD (orthogonal Procrustes; Sorkine & Alexa 2007,
+/// Eq. 6): the fallback of best_rotation().
+Matrix3 best_rotation_svd(const Matrix3& p) {
+  const Eigen::JacobiSVD<Matrix3> svd(p, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  Matrix3 v = svd.matrixV();
+  Matrix3 r = v * svd.matrixU().transpose();
+  if (r.determinant() < 0.0) {
+    v.col(2) = -v.col(2); // the smallest singular value's direction flips
+    r = v * svd.matrixU().transpose();
+  }
+  return r;
+}
+
+/// The symmetric factor S of the polar decomposition M = R S (S = V Σ Vᵀ).
+Matrix3 stretch_of(const Matrix3& m) {
+  const Eigen::JacobiSVD<Matrix3> svd(m, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  return svd.matrixV() * svd.singularValues().asDiagonal() * svd.matrixV().transpose();
+}
+
+bool is_identity(const AffineMap& t) {
+  AffineMap id = AffineMap::Zero();
+  id.leftCols<3>().setIdentity();
+  return t == id;
+}
+
+} // namespace
+
+// tr(R(q) P) = qᵀ N q for unit quaternions q (Horn 1987, §4 with P = Σ p qᵀ, rest times current):
+// the best rotation is the eigenvector of N's largest eigenvalue. N + c I with c >= ‖N‖₂ (c =
+// √3 ‖P‖_F bounds the nuclear norm of P, hence every |λ(N)|) is positive semi-definite, and the
+// Rayleigh quotient of a PSD matrix does not decrease under multiplication by it, so
+// (N + c I)^(2^k) q₀ is at least as good as the start q₀ and converges to the best: up to eight
+// squarings, fewer once q is an eigenvector to round-off (a warm start). One call reaches the best
+// unless N's two largest eigenvalues nearly coincide; the iteration's next local step goes on.
+Eigen::Matrix3d best_rotation(const Eigen::Matrix3d& p, const Eigen::Matrix3d& start) {
+  const double sxx = p(0, 0), sxy = p(0, 1), sxz = p(0, 2), syx = p(1, 0), syy = p(1, 1),
+               syz = p(1, 2), szx = p(2, 0), szy = p(2, 1), szz = p(2, 2);
+  Eigen::Matrix4d n;
+  n << sxx + syy + szz, syz - szy, szx - sxz, sxy - syx, //
+      syz - szy, sxx - syy - szz, sxy + syx, szx + sxz,  //
+      szx - sxz, sxy + syx, -sxx + syy - szz, syz + szy, //
+      sxy - syx, szx + sxz, syz + szy, -sxx - syy + szz;
+  const double scale = std::sqrt(3.0) * p.norm();
+  if (!(scale > 0.0) || !std::isfinite(scale)) return start;
+  n /= scale;
+  n.diagonal().array() += 1.0;
+  const Eigen::Matrix4d shifted = n;
+  const Eigen::Quaterniond q0(start);
+  const Eigen::Vector4d start_q(q0.w(), q0.x(), q0.y(), q0.z());
+  Eigen::Vector4d q = start_q;
+  for (int k = 0; k < 8; ++k) {
+    n = (n * n).eval();
+    n /= n.cwiseAbs().maxCoeff();
+    if (k % 2 == 0) continue;
+    // Every second squaring: done when q is an eigenvector to round-off (a warm start).
+    q = n * start_q;
+    const double length = q.norm();
+    if (!(length > 1e-150) || !std::isfinite(length)) return best_rotation_svd(p);
+    q /= length;
+    const Eigen::Vector4d nq = shifted * q;
+    if ((nq - q.dot(nq) * q).norm() < 1e-13) break;
+  }
+  return Eigen::Quaterniond(q[0], q[1], q[2], q[3]).toRotationMatrix();
+}
+
+std::string to_string(EditMethod method) {
+  return method == EditMethod::Linear ? "linear" : "nonlinear";
+}
+
+EditMethod parse_edit_method(const std::string& name) {
+  if (name == "linear") return EditMethod::Linear;
+  if (name == "nonlinear") return EditMethod::Nonlinear;
+  throw InvalidArgument(fmt::format(
+      "unknown method '{}': use linear (the paper) or nonlinear (large rotations)", name));
+}
+
+std::string to_string(NonlinearEnergy energy) {
+  return energy == NonlinearEnergy::Arap ? "arap" : "rotated-laplacian";
+}
+
+NonlinearEnergy parse_nonlinear_energy(const std::string& name) {
+  if (name == "arap") return NonlinearEnergy::Arap;
+  if (name == "rotated-laplacian") return NonlinearEnergy::RotatedLaplacian;
+  throw InvalidArgument(
+      fmt::format("unknown nonlinear energy '{}': use rotated-laplacian or arap", name));
+}
+
+struct NonlinearDeformer::Impl {
+  NonlinearOptions options;
+  double a = 1.0, beta = 1.0; // the energy's weights
+  std::size_t n = 0;
+  std::vector<int> labels;
+  std::vector<int> free_vertices, row_of; // row_of: vertex -> free row or -1
+  std::vector<int> cells, cell_of;        // free vertices and their neighbours
+  // Per cell: its W row (neighbour, weight), CSR; the diagonal separately.
+  std::vector<int> ring_begin, ring_vertex;
+  std::vector<double> ring_weight, diagonal;
+  RowPoints rest, x;                      // x⁰ and the current positions (every vertex)
+  RowPoints delta;                        // per cell: (W x⁰)_m
+  Eigen::MatrixXd weights;                // n × h handle weights
+  std::vector<Matrix3> stretch, rotation; // per cell
+  bool stretched = false;
+  Eigen::MatrixXd rhs_constrained; // nf × 3
+  std::unique_ptr<Solver> solver;
+  double edge_length = 1.0;
+  std::size_t negative_weights = 0; // of B0, clamped (both directions counted)
+  NonlinearStats stats;
+  double current_energy = 0.0;
+  bool identity = true;
+  // Anderson history: columns of differences of G values and residuals.
+  Eigen::MatrixXd dg, df;
+  Eigen::VectorXd last_g, last_f;
+  Eigen::VectorXd previous_guess;                 // the free rows of the last guess (x⁰ at first)
+  int plain_steps = 0;                            // iterations left without an extrapolation
+  std::array<double, 3> decreases{0.0, 0.0, 0.0}; // of E in the last three iterations
+  int history = 0;
+
+  std::size_t nf() const { return free_vertices.size(); }
+
+  Eigen::VectorXd free_vector() const {
+    Eigen::VectorXd u(static_cast<Eigen::Index>(3 * nf()));
+    for (std::size_t r = 0; r < nf(); ++r)
+      for (int c = 0; c < 3; ++c) u[static_cast<Eigen::Index>(3 * r + c)] = x(free_vertices[r], c);
+    return u;
+  }
+  void set_free(const Eigen::VectorXd& u) {
+    for (std::size_t r = 0; r < nf(); ++r)
+      for (int c = 0; c < 3; ++c) x(free_vertices[r], c) = u[static_cast<Eigen::Index>(3 * r + c)];
+  }
+
+  Vector3 laplacian(const RowPoints& p, std::size_t cell) const {
+    const int m = cells[cell];
+    Vector3 s = diagonal[cell] * p.row(m).transpose();
+    for (int k = ring_begin[cell]; k < ring_begin[cell + 1]; ++k)
+      s += ring_weight[static_cast<std::size_t>(k)] *
+           p.row(ring_vertex[static_cast<std::size_t>(k)]).transpose();
+    return s;
+  }
+
+  /// Local step on the current x: the best rotation per cell; returns E.
+  double local_step(std::vector<Matrix3>& out) const {
+    std::vector<double> cell_energy(cells.size());
+    parallel_for(cells.size(), options.threads, [&](std::size_t c) {
+      const int m = cells[c];
+      const Matrix3& s = stretch[c];
+      Matrix3 p = Matrix3::Zero();
+      Vector3 r, d;
+      if (a > 0.0) {
+        r = laplacian(x, c);
+        d = stretched ? Vector3(s * delta.row(static_cast<Eigen::Index>(c)).transpose())
+                      : Vector3(delta.row(static_cast<Eigen::Index>(c)).transpose());
+        p += a * d * r.transpose();
+      }
+      // The ring's current and rest edges, kept for the energy (a ring longer than the buffer
+      // computes them again).
+      constexpr int kBuffer = 24;
+      std::array<Vector3, kBuffer> es, e0s;
+      const auto edge = [&](int k, Vector3& e, Vector3& e0) {
+        const int j = ring_vertex[static_cast<std::size_t>(k)];
+        e = (x.row(m) - x.row(j)).transpose();
+        e0 = (rest.row(m) - rest.row(j)).transpose();
+        if (stretched) e0 = s * e0;
+      };
+      for (int k = ring_begin[c]; k < ring_begin[c + 1]; ++k) {
+        Vector3 e, e0;
+        edge(k, e, e0);
+        if (k - ring_begin[c] < kBuffer) {
+          es[static_cast<std::size_t>(k - ring_begin[c])] = e;
+          e0s[static_cast<std::size_t>(k - ring_begin[c])] = e0;
+        }
+        p += (beta * ring_weight[static_cast<std::size_t>(k)]) * e0 * e.transpose();
+      }
+      const Matrix3 rot = best_rotation(p, rotation[c]);
+      out[c] = rot;
+      double energy = 0.0;
+      if (a > 0.0) energy += a * (r - rot * d).squaredNorm();
+      for (int k = ring_begin[c]; k < ring_begin[c + 1]; ++k) {
+        Vector3 e, e0;
+        if (k - ring_begin[c] < kBuffer) {
+          e = es[static_cast<std::size_t>(k - ring_begin[c])];
+          e0 = e0s[static_cast<std::size_t>(k - ring_begin[c])];
+        } else {
+          edge(k, e, e0);
+        }
+        energy += beta * ring_weight[static_cast<std::size_t>(k)] * (e - rot * e0).squaredNorm();
+      }
+      cell_energy[c] = energy;
+    });
+    double e = 0.0;
+    for (const double v : cell_energy) e += v;
+    return e;
+  }
+
+  /// Global step: the free positions minimizing E for the rotations `rot`, as a vector.
+  Eigen::VectorXd global_step(const std::vector<Matrix3>& rot) const {
+    // t_m = R_m S_m δ_m per cell.
+    RowPoints t(static_cast<Eigen::Index>(cells.size()), 3);
+    std::vector<Matrix3> rs(cells.size());
+    parallel_for(cells.size(), options.threads, [&](std::size_t c) {
+      rs[c] = stretched ? Matrix3(rot[c] * stretch[c]) : rot[c];
+      t.row(static_cast<Eigen::Index>(c)) =
+          (rs[c] * delta.row(static_cast<Eigen::Index>(c)).transpose()).transpose();
+    });
+    Eigen::MatrixXd rhs = rhs_constrained;
+    parallel_for(nf(), options.threads, [&](std::size_t row) {
+      const int i = free_vertices[row];
+      const auto ci = static_cast<std::size_t>(cell_of[static_cast<std::size_t>(i)]);
+      Vector3 s = Vector3::Zero();
+      if (a > 0.0) s += a * diagonal[ci] * t.row(static_cast<Eigen::Index>(ci)).transpose();
+      for (int k = ring_begin[ci]; k < ring_begin[ci + 1]; ++k) {
+        const int j = ring_vertex[static_cast<std::size_t>(k)];
+        const double w = ring_weight[static_cast<std::size_t>(k)];
+        const auto cj = static_cast<std::size_t>(cell_of[static_cast<std::size_t>(j)]);
+        if (a > 0.0) s += a * w * t.row(static_cast<Eigen::Index>(cj)).transpose();
+        const Vector3 e0 = (rest.row(i) - rest.row(j)).transpose();
+        s += beta * w * ((rs[ci] + rs[cj]) * e0);
+      }
+      rhs.row(static_cast<Eigen::Index>(row)) += s.transpose();
+    });
+    const Eigen::MatrixXd sol = solver->solve(rhs);
+    Eigen::VectorXd u(static_cast<Eigen::Index>(3 * nf()));
+    for (std::size_t r = 0; r < nf(); ++r)
+      for (int c = 0; c < 3; ++c)
+        u[static_cast<Eigen::Index>(3 * r + c)] = sol(static_cast<Eigen::Index>(r), c);
+    return u;
+  }
+
+  void build(const Mesh& base, const Eigen::MatrixXd& rest_positions);
+  void update_constrained_rhs();
+  double max_move(const Eigen::VectorXd& u, const Eigen::VectorXd& v) const {
+    double worst = 0.0;
+    for (std::size_t r = 0; r < nf(); ++r)
+      worst = std::max(worst, (u.segment<3>(static_cast<Eigen::Index>(3 * r)) -
+                               v.segment<3>(static_cast<Eigen::Index>(3 * r)))
+                                  .norm());
+    return worst;
+  }
+  Eigen::VectorXd anderson(const Eigen::VectorXd& g, const Eigen::VectorXd& f);
+  void iterate();
+};
+
+void NonlinearDeformer::Impl::build(const Mesh& base, const Eigen::MatrixXd& rest_positions) {
+  n = base.n_vertices();
+  row_of.assign(n, -1);
+  for (std::size_t v = 0; v < n; ++v)
+    if (labels[v] == Region::kFree) {
+      row_of[v] = static_cast<int>(free_vertices.size());
+      free_vertices.push_back(static_cast<int>(v));
+    }
+  if (free_vertices.empty()) throw InvalidArgument("nonlinear deformer: no free vertex");
+  // The rest shape's own cotan weights (not B's: B0 can be far from B inside the support), with
+  // negative ones clamped to 0 so that the global matrix stays positive definite.
+  Mesh shape = base;
+  set_positions(shape, rest_positions);
+  SparseMatrix w = cotan_weights(shape);
+  negative_weights = 0;
+  for (Eigen::Index col = 0; col < w.outerSize(); ++col)
+    for (SparseMatrix::InnerIterator it(w, col); it; ++it)
+      if (it.row() != it.col() && it.value() < 0.0) {
+        ++negative_weights;
+        it.valueRef() = 0.0;
+      }
+  for (Eigen::Index col = 0; col < w.outerSize(); ++col) { // the diagonal: minus the row's sum
+    double sum = 0.0;
+    for (SparseMatrix::InnerIterator it(w, col); it; ++it)
+      if (it.row() != it.col()) sum += it.value();
+    w.coeffRef(col, col) = -sum;
+  }
+  // β = rigidity × (mean vertex area) / (the support's area) = rigidity / n_free: the two terms
+  // keep their ratio when the base is refined or the shape scaled (docs/editing.md).
+  if (a > 0.0) beta = options.rigidity / static_cast<double>(free_vertices.size());
+  std::vector<char> in_cell(n, 0);
+  for (const int v : free_vertices)
+    for (SparseMatrix::InnerIterator it(w, v); it; ++it)
+      in_cell[static_cast<std::size_t>(it.row())] = 1;
+  cell_of.assign(n, -1);
+  for (std::size_t v = 0; v < n; ++v)
+    if (in_cell[v]) {
+      cell_of[v] = static_cast<int>(cells.size());
+      cells.push_back(static_cast<int>(v));
+    }
+  ring_begin.push_back(0);
+  for (const int m : cells) {
+    double d = 0.0;
+    for (SparseMatrix::InnerIterator it(w, m); it; ++it) {
+      if (it.row() == m) {
+        d += it.value();
+        continue;
+      }
+      ring_vertex.push_back(static_cast<int>(it.row()));
+      ring_weight.push_back(it.value());
+    }
+    diagonal.push_back(d);
+    ring_begin.push_back(static_cast<int>(ring_vertex.size()));
+  }
+  rest = rest_positions;
+  x = rest;
+  delta.resize(static_cast<Eigen::Index>(cells.size()), 3);
+  for (std::size_t c = 0; c < cells.size(); ++c)
+    delta.row(static_cast<Eigen::Index>(c)) = laplacian(rest, c).transpose();
+  stretch.assign(cells.size(), Matrix3::Identity());
+  rotation.assign(cells.size(), Matrix3::Identity());
+
+  // K = a (W²)_FF − 2β W_FF.
+  const auto nfree = static_cast<Eigen::Index>(nf());
+  SparseMatrix select(static_cast<Eigen::Index>(n), nfree);
+  std::vector<Eigen::Triplet<double>> triplets;
+  for (std::size_t r = 0; r < nf(); ++r)
+    triplets.emplace_back(free_vertices[r], static_cast<Eigen::Index>(r), 1.0);
+  select.setFromTriplets(triplets.begin(), triplets.end());
+  const SparseMatrix wf = w * select;
+  SparseMatrix k = SparseMatrix(select.transpose() * wf) * (-2.0 * beta);
+  if (a > 0.0) k += a * SparseMatrix(wf.transpose() * wf);
+  const SparseMatrix kt = k.transpose();
+  k = 0.5 * (k + kt);
+  k.makeCompressed();
+  SolverOptions so = options.solver;
+  if (so.name.empty()) so.name = default_solver_name();
+  solver = make_solver(so);
+  solver->compute(k);
+
+  // The base's mean edge length over the cells (the tolerance's unit).
+  double sum = 0.0;
+  std::size_t count = 0;
+  for (std::size_t c = 0; c < cells.size(); ++c)
+    for (int kk = ring_begin[c]; kk < ring_begin[c + 1]; ++kk) {
+      sum += (rest.row(cells[c]) - rest.row(ring_vertex[static_cast<std::size_t>(kk)])).norm();
+      ++count;
+    }
+  edge_length = count > 0 && sum > 0.0 ? sum / static_cast<double>(count) : 1.0;
+}
+
+// −K_FC x_C = −a (W (W x̃))_F + 2β (W x̃)_F with x̃ the constrained values (free rows zero).
+void NonlinearDeformer::Impl::update_constrained_rhs() {
+  RowPoints xc = x;
+  for (const int v : free_vertices) xc.row(v).setZero();
+  RowPoints y(static_cast<Eigen::Index>(cells.size()), 3);
+  parallel_for(cells.size(), options.threads, [&](std::size_t c) {
+    y.row(static_cast<Eigen::Index>(c)) = laplacian(xc, c).transpose();
+  });
+  rhs_constrained.resize(static_cast<Eigen::Index>(nf()), 3);
+  parallel_for(nf(), options.threads, [&](std::size_t row) {
+    const auto ci = static_cast<std::size_t>(cell_of[static_cast<std::size_t>(free_vertices[row])]);
+    Vector3 s = 2.0 * beta * y.row(static_cast<Eigen::Index>(ci)).transpose();
+    if (a > 0.0) {
+      Vector3 wy = diagonal[ci] * y.row(static_cast<Eigen::Index>(ci)).transpose();
+      for (int k = ring_begin[ci]; k < ring_begin[ci + 1]; ++k) {
+        const auto cj = static_cast<std::size_t>(
+            cell_of[static_cast<std::size_t>(ring_vertex[static_cast<std::size_t>(k)])]);
+        wy += ring_weight[static_cast<std::size_t>(k)] *
+              y.row(static_cast<Eigen::Index>(cj)).transpose();
+      }
+      s -= a * wy;
+    }
+    rhs_constrained.row(static_cast<Eigen::Index>(row)) = s.transpose();
+  });
+}
+
+// Anderson's extrapolation from the history and the newest (g, f) (Walker & Ni 2011).
+Eigen::VectorXd NonlinearDeformer::Impl::anderson(const Eigen::VectorXd& g,
+                                                  const Eigen::VectorXd& f) {
+  const int depth = options.anderson;
+  if (last_g.size() == g.size()) {
+    if (dg.cols() != depth || dg.rows() != g.size()) {
+      dg.resize(g.size(), depth);
+      df.resize(g.size(), depth);
+      history = 0;
+    }
+    const int slot = history % depth;
+    dg.col(slot) = g - last_g;
+    df.col(slot) = f - last_f;
+    ++history;
+  }
+  last_g = g;
+  last_f = f;
+  const int m = std::min(history, depth);
+  if (m == 0) return g;
+  const Eigen::MatrixXd dfm = df.leftCols(m), dgm = dg.leftCols(m);
+  Eigen::MatrixXd normal = dfm.transpose() * dfm;
+  normal.diagonal().array() += 1e-12 * normal.diagonal().maxCoeff() + 1e-300;
+  const Eigen::VectorXd theta = normal.ldlt().solve(dfm.transpose() * f);
+  return g - dgm * theta;
+}
+
+void NonlinearDeformer::Impl::iterate() {
+  const Eigen::VectorXd u = free_vector();
+  const double before = current_energy;
+  const Eigen::VectorXd g = global_step(rotation);
+  const Eigen::VectorXd f = g - u;
+  std::vector<Matrix3> rot(cells.size());
+  bool accepted = false;
+  if (options.anderson > 0) {
+    const Eigen::VectorXd candidate = anderson(g, f);
+    // After a rejected extrapolation the next two iterations are plain (each test costs a local
+    // step).
+    if (plain_steps > 0) {
+      --plain_steps;
+    } else if (history > 0 && candidate.allFinite()) {
+      set_free(candidate);
+      const double e = local_step(rot);
+      if (e < current_energy) {
+        accepted = true;
+        current_energy = e;
+        ++stats.accelerated;
+      } else { // keep only the newest point
+        history = 0;
+        plain_steps = 2;
+      }
+    }
+  }
+  if (!accepted) {
+    set_free(g);
+    current_energy = local_step(rot);
+  }
+  rotation.swap(rot);
+  stats.last_move = max_move(free_vector(), u) / edge_length;
+  stats.energy.push_back(current_energy);
+  ++stats.iterations;
+  ++stats.total_iterations;
+  decreases[static_cast<std::size_t>(stats.total_iterations % 3)] = before - current_energy;
+  const double recent = decreases[0] + decreases[1] + decreases[2];
+  stats.converged =
+      stats.last_move < options.tolerance ||
+      (stats.total_iterations >= 3 && recent <= 3.0 * options.energy_tolerance * current_energy);
+  stats.exhausted = !stats.converged && stats.total_iterations >= options.max_iterations;
+}
+
+NonlinearDeformer::NonlinearDeformer(const Mesh& base, const Eigen::MatrixXd& rest,
+                                     const std::vector<int>& labels,
+                                     const Eigen::MatrixXd& handle_weights,
+                                     const NonlinearOptions& options)
+    : impl_(std::make_unique<Impl>()) {
+  Impl& m = *impl_;
+  const auto n = static_cast<Eigen::Index>(base.n_vertices());
+  if (rest.rows() != n || rest.cols() != 3 || labels.size() != base.n_vertices() ||
+      handle_weights.rows() != n)
+    throw InvalidArgument(fmt::format(
+        "nonlinear deformer: {} x {} rest positions, {} labels and {} weight rows for a base of "
+        "{} vertices (one row and one label per vertex expected)",
+        rest.rows(), rest.cols(), labels.size(), handle_weights.rows(), n));
+  if (!rest.allFinite() || !handle_weights.allFinite())
+    throw InvalidArgument("nonlinear deformer: a rest position or weight is not finite");
+  if (!(options.rigidity > 0.0) || options.max_iterations < 1 || !(options.tolerance > 0.0) ||
+      !(options.energy_tolerance >= 0.0) || options.anderson < 0)
+    throw InvalidArgument("nonlinear deformer: rigidity and tolerance must be > 0, "
+                          "energy_tolerance >= 0, max_iterations >= 1 and anderson >= 0");
+  m.options = options;
+  m.labels = labels;
+  m.weights = handle_weights;
+  m.a = options.energy == NonlinearEnergy::RotatedLaplacian ? 1.0 : 0.0;
+  m.beta = options.energy == NonlinearEnergy::RotatedLaplacian ? options.rigidity : 1.0;
+  try {
+    m.build(base, rest);
+  } catch (const NumericalError& e) {
+    throw NumericalError(std::string("nonlinear deformer: the global matrix: ") + e.what());
+  }
+  m.update_constrained_rhs();
+  m.previous_guess = m.free_vector();
+  m.stats.converged = true;
+}
+
+NonlinearDeformer::~NonlinearDeformer() = default;
+NonlinearDeformer::NonlinearDeformer(NonlinearDeformer&&) noexcept = default;
+NonlinearDeformer& NonlinearDeformer::operator=(NonlinearDeformer&&) noexcept = default;
+
+void NonlinearDeformer::set_transforms(const std::vector<AffineMap>& transforms,
+                                       const RowPoints* guess) {
+  Impl& m = *impl_;
+  const int handles = static_cast<int>(m.weights.cols());
+  if (static_cast<int>(transforms.size()) != handles)
+    throw InvalidArgument(fmt::format("nonlinear deformer: {} transforms for {} handles",
+                                      transforms.size(), handles));
+  m.stats = NonlinearStats{};
+  m.history = 0;
+  m.plain_steps = 0;
+  m.decreases = {0.0, 0.0, 0.0};
+  m.last_g.resize(0);
+  m.identity = std::all_of(transforms.begin(), transforms.end(), is_identity);
+  if (m.identity) { // E = 0 at x⁰: the minimizer, exactly
+    m.x = m.rest;
+    m.stretch.assign(m.cells.size(), Matrix3::Identity());
+    m.rotation.assign(m.cells.size(), Matrix3::Identity());
+    m.stretched = false;
+    m.current_energy = 0.0;
+    m.previous_guess = m.free_vector();
+    m.update_constrained_rhs();
+    m.stats.converged = true;
+    m.stats.energy.push_back(0.0);
+    return;
+  }
+  // Constrained values.
+  for (std::size_t v = 0; v < m.n; ++v) {
+    const int label = m.labels[v];
+    if (label >= 0) {
+      const AffineMap& t = transforms[static_cast<std::size_t>(label)];
+      m.x.row(static_cast<Eigen::Index>(v)) =
+          (t.leftCols<3>() * m.rest.row(static_cast<Eigen::Index>(v)).transpose() + t.col(3))
+              .transpose();
+    } else if (label == Region::kFixed) {
+      m.x.row(static_cast<Eigen::Index>(v)) = m.rest.row(static_cast<Eigen::Index>(v));
+    }
+  }
+  // Stretches blended by the handle weights.
+  std::vector<Matrix3> handle_stretch;
+  m.stretched = false;
+  for (const AffineMap& t : transforms) {
+    handle_stretch.push_back(stretch_of(t.leftCols<3>()));
+    if (!(handle_stretch.back() - Matrix3::Identity()).isZero(1e-12)) m.stretched = true;
+  }
+  for (std::size_t c = 0; c < m.cells.size(); ++c) {
+    if (!m.stretched) {
+      m.stretch[c].setIdentity();
+      continue;
+    }
+    const auto v = static_cast<Eigen::Index>(m.cells[c]);
+    Matrix3 s = Matrix3::Zero();
+    double total = 0.0;
+    for (int j = 0; j < handles; ++j) {
+      const double w = m.weights(v, j);
+      s += w * handle_stretch[static_cast<std::size_t>(j)];
+      total += w;
+    }
+    m.stretch[c] = s + (1.0 - total) * Matrix3::Identity();
+  }
+  m.update_constrained_rhs();
+  // Start from the lowest-energy of: the guess, and the current free positions moved as the
+  // guess moved since the last call (a predictor along a drag); without a guess, the current
+  // positions.
+  std::vector<Matrix3> rot(m.cells.size());
+  if (!guess) {
+    m.current_energy = m.local_step(rot);
+    m.rotation.swap(rot);
+  } else {
+    Eigen::VectorXd g(static_cast<Eigen::Index>(3 * m.nf()));
+    for (std::size_t r = 0; r < m.nf(); ++r)
+      g.segment<3>(static_cast<Eigen::Index>(3 * r)) = guess->row(m.free_vertices[r]).transpose();
+    const Eigen::VectorXd predictor = m.free_vector() + (g - m.previous_guess);
+    m.current_energy = std::numeric_limits<double>::infinity();
+    Eigen::VectorXd best = g;
+    for (const Eigen::VectorXd* candidate : {&predictor, static_cast<const Eigen::VectorXd*>(&g)}) {
+      m.set_free(*candidate);
+      const double e = m.local_step(rot);
+      if (e < m.current_energy) {
+        m.current_energy = e;
+        m.rotation.swap(rot);
+        best = *candidate;
+      }
+    }
+    m.set_free(best);
+    m.previous_guess = g;
+    if (!std::isfinite(m.current_energy))
+      throw NumericalError("nonlinear deformer: the start has a non-finite energy");
+  }
+  m.stats.energy.push_back(m.current_energy);
+  m.stats.converged = false;
+}
+
+const NonlinearStats& NonlinearDeformer::solve(double budget_ms) {
+  Impl& m = *impl_;
+  m.stats.iterations = 0;
+  m.stats.accelerated = 0;
+  if (!m.stats.energy.empty())
+    m.stats.energy.erase(m.stats.energy.begin(), m.stats.energy.end() - 1);
+  if (m.stats.finished()) return m.stats;
+  const auto t0 = Clock::now();
+  do {
+    m.iterate();
+  } while (!m.stats.finished() && ms_since(t0) < budget_ms);
+  return m.stats;
+}
+
+const RowPoints& NonlinearDeformer::positions() const {
+  return impl_->x;
+}
+const std::vector<int>& NonlinearDeformer::free_vertices() const {
+  return impl_->free_vertices;
+}
+const NonlinearStats& NonlinearDeformer::stats() const {
+  return impl_->stats;
+}
+double NonlinearDeformer::energy() const {
+  return impl_->current_energy;
+}
+
+} // namespace remora

@@ -1,0 +1,453 @@
+// The nonlinear base deformation (multires/nonlinear.h) and the editor's method nonlinear: exact
+// cases (identity, rigid and affine motions), the cylinder's twist and bend against the linear
+// method, monotone energy, agreement with the linear method for small bending motions of a flat
+// support, scaled handles, a needle CAD mesh, and the fallback to the linear result.
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <iostream>
+#include <numbers>
+#include <random>
+#include <vector>
+
+#include <Eigen/Geometry>
+#include <Eigen/SVD>
+#include <fmt/format.h>
+#include <gtest/gtest.h>
+
+#include "remora/common/error.h"
+#include "remora/geometry/measures.h"
+#include "remora/geometry/selection.h"
+#include "remora/mesh/io.h"
+#include "remora/mesh/primitives.h"
+#include "remora/multires/editor.h"
+
+namespace remora {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+/// An open cylinder of radius 1 and height 4 about the z axis with radial bumps of the given
+/// amplitude: 12 around, wavelength 0.5 along z (8 base edge lengths). The support is every
+/// circle but the bottom one, the handle the top circle.
+struct Cylinder {
+  int rings = 70, segments = 96;
+  double amplitude = 0.02, height = 4.0;
+  Mesh mesh;
+  std::vector<int> support, handle;
+  int id(int k, int s) const { return k * segments + s; }
+  double bump(int k, int s) const {
+    const double phi = 2.0 * kPi * (s + (k % 2 ? 0.5 : 0.0)) / segments;
+    return std::sin(12.0 * phi) * std::sin(2.0 * kPi * (height * k / rings) / 0.5);
+  }
+};
+
+Cylinder bumpy_cylinder(int rings = 70, int segments = 96) {
+  Cylinder c;
+  c.rings = rings;
+  c.segments = segments;
+  c.mesh = make_cylinder(rings, segments, 1.0, c.height);
+  for (int k = 0; k <= rings; ++k)
+    for (int s = 0; s < segments; ++s) {
+      const VertexHandle v(c.id(k, s));
+      Vec3 p = c.mesh.point(v);
+      const double r = 1.0 + c.amplitude * c.bump(k, s);
+      p[0] *= r;
+      p[1] *= r;
+      c.mesh.set_point(v, p);
+      if (k > 0) c.support.push_back(v.idx());
+      if (k == rings) c.handle.push_back(v.idx());
+    }
+  return c;
+}
+
+struct Rings {
+  double worst_radius_error = 0.0; ///< the largest |mean radius − 1| of a circle of the input
+  double amplitude = 0.0;          ///< the bumps' least-squares amplitude over the input's
+};
+
+/// Each circle of the input (k = 0 .. rings) in `p`: its mean distance from its centroid, and the
+/// bumps as the least-squares multiple of the input's pattern in the distances' deviations.
+Rings rings(const Cylinder& c, const Eigen::MatrixXd& p) {
+  Rings f;
+  double dot = 0.0, norm = 0.0;
+  for (int k = 0; k <= c.rings; ++k) {
+    Eigen::RowVector3d centre = Eigen::RowVector3d::Zero();
+    for (int s = 0; s < c.segments; ++s) centre += p.row(c.id(k, s));
+    centre /= c.segments;
+    std::vector<double> r;
+    double mean = 0.0;
+    for (int s = 0; s < c.segments; ++s) {
+      r.push_back((p.row(c.id(k, s)) - centre).norm());
+      mean += r.back() / c.segments;
+    }
+    f.worst_radius_error = std::max(f.worst_radius_error, std::abs(mean - 1.0));
+    for (int s = 0; s < c.segments; ++s) {
+      dot += (r[static_cast<std::size_t>(s)] - mean) * c.bump(k, s);
+      norm += c.bump(k, s) * c.bump(k, s);
+    }
+  }
+  f.amplitude = dot / (norm * c.amplitude);
+  return f;
+}
+
+Transform twist(const Cylinder& c, double radians) {
+  return rotation({0, 0, 1}, radians, {0, 0, c.height});
+}
+
+/// The top circle where bending the axis into an arc of length `height` that turns by `radians`
+/// about y puts it: turned by `radians`, its centre at the arc's end.
+Transform bend(const Cylinder& c, double radians) {
+  const double rho = c.height / radians;
+  Transform t = rotation({0, 1, 0}, radians, {0, 0, 0});
+  const Eigen::Vector3d end(rho * (1.0 - std::cos(radians)), 0.0, rho * std::sin(radians));
+  t.col(3) = end - t.leftCols<3>() * Eigen::Vector3d(0, 0, c.height);
+  return t;
+}
+
+EditorOptions nonlinear_options() {
+  EditorOptions o;
+  o.method = EditMethod::Nonlinear;
+  return o;
+}
+
+double max_row_distance(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
+  return (a - b).rowwise().norm().maxCoeff();
+}
+
+void expect_monotone(const std::vector<double>& energy, const std::string& what) {
+  ASSERT_FALSE(energy.empty()) << what;
+  for (std::size_t i = 1; i < energy.size(); ++i)
+    EXPECT_LE(energy[i], energy[i - 1] * (1.0 + 1e-12) + 1e-300) << what << ", iteration " << i;
+}
+
+TEST(Nonlinear, TheIdentityGivesTheInputExactly) {
+  const Cylinder c = bumpy_cylinder(24, 32);
+  Editor editor(c.mesh, nonlinear_options());
+  editor.set_region(c.support, {c.handle});
+  const Eigen::MatrixXd rest = editor.base_positions();
+  editor.set_transform(0, twist(c, kPi / 2));
+  EXPECT_GT(max_row_distance(editor.positions(), positions_matrix(c.mesh)), 0.5);
+  editor.set_transform(0, identity_transform());
+  EXPECT_EQ(editor.base_positions(), rest); // B0 bit for bit: the minimizer, no iteration
+  EXPECT_LT(max_row_distance(editor.positions(), positions_matrix(c.mesh)), 1e-10 * c.height);
+  EXPECT_TRUE(editor.converged());
+  EXPECT_EQ(editor.report().method, "nonlinear");
+}
+
+// E = 0 at the moved rest shape and nowhere else: a rigid motion of every constraint moves the
+// result rigidly, and (the stretch blended by the weights) so does an affine map of every handle
+// when nothing is fixed.
+TEST(Nonlinear, OneMotionOfEveryConstraintMovesTheResultByIt) {
+  Mesh sphere = make_icosphere(3, 1.0);
+  for (const VertexHandle v : sphere.vertices()) {
+    const Vec3 p = sphere.point(v);
+    sphere.set_point(v, p * (1.0 + 0.03 * std::sin(9 * p[0]) * std::sin(9 * p[1])));
+  }
+  std::vector<int> all(sphere.n_vertices());
+  for (std::size_t i = 0; i < all.size(); ++i) all[i] = static_cast<int>(i);
+  const auto top = select_sphere(sphere, Vec3(0, 0, 1), 0.5);
+  const auto bottom = select_sphere(sphere, Vec3(0, 0, -1), 0.5);
+  Editor editor(sphere, nonlinear_options());
+  editor.set_region(all, {top, bottom});
+  const Eigen::MatrixXd rest = editor.base_positions();
+  const double diagonal = bounding_box_diagonal(sphere);
+  const Transform rigid =
+      compose(translation({0.4, -0.2, 1.5}), rotation({1, 2, 3}, 2.0, {0.1, 0.2, 0.3}));
+  const Transform affine = compose(rigid, scaling({1.5, 0.7, 1.1}, {0.1, 0.0, 0.2}));
+  for (const Transform& t : {rigid, affine}) {
+    editor.set_transform(0, t);
+    editor.set_transform(1, t);
+    const Eigen::MatrixXd moved =
+        ((t.leftCols<3>() * rest.transpose()).colwise() + t.col(3)).transpose();
+    EXPECT_LT(max_row_distance(editor.base_positions(), moved), 1e-9 * diagonal);
+    EXPECT_TRUE(editor.converged());
+    EXPECT_LT(editor.report().nonlinear.total_iterations, 3);
+  }
+  // The details ride along a rigid motion exactly.
+  editor.set_transform(0, rigid);
+  editor.set_transform(1, rigid);
+  const Eigen::MatrixXd input = positions_matrix(sphere);
+  const Eigen::MatrixXd expected =
+      ((rigid.leftCols<3>() * input.transpose()).colwise() + rigid.col(3)).transpose();
+  EXPECT_LT(max_row_distance(editor.positions(), expected), 1e-9 * diagonal);
+}
+
+// The linear method's known failure (Botsch & Sorkine 2008): a rotated handle shrinks the
+// support. Measured on every circle of the input: the mean radius and the bumps' amplitude.
+TEST(Nonlinear, TheCylinderKeepsItsRadiusAndBumpsWhenTwistedAndBent) {
+  const Cylinder c = bumpy_cylinder();
+  Editor linear(c.mesh), nonlinear(c.mesh, nonlinear_options());
+  linear.set_region(c.support, {c.handle});
+  nonlinear.set_region(c.support, {c.handle});
+  for (const bool twisted : {true, false}) {
+    const Transform t = twisted ? twist(c, kPi / 2) : bend(c, kPi / 2);
+    linear.set_transform(0, t);
+    nonlinear.set_transform(0, t);
+    const Rings l = rings(c, linear.positions()), n = rings(c, nonlinear.positions());
+    const NonlinearStats& s = nonlinear.report().nonlinear;
+    std::cout << (twisted ? "twist" : "bend") << " 90 deg: radius error linear "
+              << l.worst_radius_error << ", nonlinear " << n.worst_radius_error << "; bumps linear "
+              << l.amplitude << ", nonlinear " << n.amplitude << "; " << s.iterations
+              << " iterations\n";
+    EXPECT_GT(l.worst_radius_error, 0.09);
+    EXPECT_LT(n.worst_radius_error, twisted ? 0.065 : 0.045);
+    EXPECT_LT(n.worst_radius_error, 0.4 * l.worst_radius_error);
+    EXPECT_GT(n.amplitude, 0.95);
+    EXPECT_LT(n.amplitude, 1.05);
+    EXPECT_TRUE(nonlinear.converged());
+    EXPECT_TRUE(nonlinear.report().fallback.empty());
+    expect_monotone(s.energy, twisted ? "twist" : "bend");
+  }
+}
+
+// A large support is previewed on a coarse remesh of the base while a handle is dragged: close to
+// the fine result and exact at the identity; the fine iteration takes over and converges.
+TEST(Nonlinear, TheCoarsePreviewIsCloseAndTheFineLevelTakesOver) {
+  const Cylinder c = bumpy_cylinder(48, 64);
+  EditorOptions o = nonlinear_options();
+  o.nonlinear.preview_vertices = 400;
+  Editor editor(c.mesh, o);
+  editor.set_region(c.support, {c.handle});
+  EXPECT_GT(editor.report().free_base_vertices, 800u);
+  const Eigen::MatrixXd input = positions_matrix(c.mesh);
+  // A drag: a frame's budget, then the fine level until converged.
+  editor.set_transform(0, twist(c, kPi / 2));
+  const Eigen::MatrixXd preview = editor.positions(1e-3);
+  EXPECT_EQ(editor.report().nonlinear_level, "coarse");
+  EXPECT_FALSE(editor.converged());
+  const Eigen::MatrixXd fine = editor.positions();
+  EXPECT_EQ(editor.report().nonlinear_level, "fine");
+  EXPECT_TRUE(editor.converged());
+  const double preview_error = rings(c, preview).worst_radius_error;
+  const double fine_error = rings(c, fine).worst_radius_error;
+  std::cout << "preview: radius error " << preview_error << " (fine " << fine_error
+            << "), largest distance to the fine result " << max_row_distance(preview, fine) << "\n";
+  EXPECT_LT(preview_error, 0.1);
+  EXPECT_LT(max_row_distance(preview, fine), 0.1);
+  // Exact cases through the preview.
+  editor.set_transform(0, identity_transform());
+  EXPECT_LT(max_row_distance(editor.positions(1e-3), input), 1e-10 * c.height);
+}
+
+TEST(Nonlinear, TheEnergyNeverIncreases) {
+  const Cylinder c = bumpy_cylinder(24, 32);
+  for (const int anderson : {0, 5}) {
+    EditorOptions o = nonlinear_options();
+    o.nonlinear.anderson = anderson;
+    o.nonlinear.tolerance = 1e-7;
+    o.nonlinear.energy_tolerance = 0.0;
+    Editor editor(c.mesh, o);
+    editor.set_region(c.support, {c.handle});
+    editor.set_transform(0, compose(translation({0.5, 0, 0}), bend(c, 2.0)));
+    editor.positions();
+    const NonlinearStats& s = editor.report().nonlinear;
+    EXPECT_GT(s.iterations, 5) << anderson;
+    EXPECT_LT(s.energy.back(), 0.5 * s.energy.front()) << anderson;
+    expect_monotone(s.energy, fmt::format("anderson {}", anderson));
+  }
+}
+
+// What the two methods share for small motions: on a flat support, bending (the handle lifted
+// along the normal or tilted about an in-plane axis) gives the same result to second order, the
+// difference shrinking like the square of the motion. (Where the support is curved, or the handle
+// moves in the plane, they differ at first order: docs/editing.md.)
+TEST(Nonlinear, SmallBendingMotionsOfAFlatSupportAgreeWithLinearToSecondOrder) {
+  const Mesh disc = make_disc(24, 6, 1.0);
+  std::vector<int> support, handle;
+  for (const VertexHandle v : disc.vertices()) {
+    const double r = disc.point(v).norm();
+    if (r < 0.9) support.push_back(v.idx());
+    if (r < 0.2) handle.push_back(v.idx());
+  }
+  EditorOptions o = nonlinear_options();
+  o.nonlinear.tolerance = 1e-10;
+  o.nonlinear.energy_tolerance = 0.0;
+  o.nonlinear.max_iterations = 1000;
+  Editor linear(disc), nonlinear(disc, o);
+  linear.set_region(support, {handle});
+  nonlinear.set_region(support, {handle});
+  const Eigen::MatrixXd rest = linear.base_positions();
+  for (const bool lift : {true, false}) {
+    double ratio[2];
+    for (int i = 0; i < 2; ++i) {
+      const double e = i == 0 ? 0.1 : 0.05;
+      const Transform t = lift ? translation({0, 0, e}) : rotation({1, 0, 0}, e, {0, 0, 0});
+      linear.set_transform(0, t);
+      nonlinear.set_transform(0, t);
+      const Eigen::MatrixXd a = linear.base_positions();
+      ratio[i] = (nonlinear.base_positions() - a).norm() / (a - rest).norm();
+    }
+    std::cout << (lift ? "lift" : "tilt")
+              << ": |nonlinear - linear| / |linear - rest| = " << ratio[0] << " at 0.1, "
+              << ratio[1] << " at 0.05\n";
+    EXPECT_LT(ratio[0], 0.05);
+    EXPECT_NEAR(ratio[1] / ratio[0], 0.5, 0.05); // the difference is of second order
+  }
+}
+
+// A scaled handle: the stretch is blended by the handles' weights and the rest rotates. Scaling
+// the cylinder's top by 1.5 flares it as the linear method does (right for a scaling); scaling it
+// by 1.5 along x and twisting it by 90° flares it without the linear method's shrinking.
+TEST(Nonlinear, AScaledHandleFlaresTheSupportLikeTheLinearMethod) {
+  const Cylinder c = bumpy_cylinder(24, 32);
+  Editor linear(c.mesh), nonlinear(c.mesh, nonlinear_options());
+  linear.set_region(c.support, {c.handle});
+  nonlinear.set_region(c.support, {c.handle});
+  const auto radii = [&c](const Eigen::MatrixXd& p) {
+    std::vector<double> r(static_cast<std::size_t>(c.rings + 1), 0.0);
+    for (int k = 0; k <= c.rings; ++k)
+      for (int s = 0; s < c.segments; ++s)
+        r[static_cast<std::size_t>(k)] += p.row(c.id(k, s)).head<2>().norm() / c.segments;
+    return r;
+  };
+  for (const bool twisted : {false, true}) {
+    const Transform t = twisted ? compose(twist(c, kPi / 2), scaling({1.5, 1.0, 1.0}, {0, 0, 4}))
+                                : scaling({1.5, 1.5, 1.5}, {0, 0, c.height});
+    linear.set_transform(0, t);
+    nonlinear.set_transform(0, t);
+    const std::vector<double> a = radii(linear.positions()), b = radii(nonlinear.positions());
+    double worst = 0.0;
+    for (std::size_t k = 0; k < a.size(); ++k) worst = std::max(worst, std::abs(b[k] - a[k]));
+    const double smallest_a = *std::min_element(a.begin(), a.end());
+    const double smallest_b = *std::min_element(b.begin(), b.end());
+    std::cout << (twisted ? "scaled and twisted" : "scaled") << " handle: radii differ from the "
+              << "linear method's by at most " << worst << "; smallest mean radius linear "
+              << smallest_a << ", nonlinear " << smallest_b << "\n";
+    EXPECT_NEAR(b.back(), a.back(), 0.01); // the top circle: where the handle puts it
+    if (twisted) {
+      EXPECT_LT(smallest_a, 0.9);
+      EXPECT_GT(smallest_b, 0.94);
+    } else {
+      EXPECT_LT(worst, 0.03);
+    }
+    EXPECT_TRUE(nonlinear.converged());
+  }
+}
+
+TEST(Nonlinear, AFailingIterationShowsTheLinearResultWithAMessage) {
+  const Cylinder c = bumpy_cylinder(24, 32);
+  EditorOptions o = nonlinear_options();
+  o.nonlinear.solver.name = "cg"; // an iterative global step that cannot converge in 1 step
+  o.nonlinear.solver.max_iterations = 1;
+  Editor linear(c.mesh), nonlinear(c.mesh, o);
+  linear.set_region(c.support, {c.handle});
+  nonlinear.set_region(c.support, {c.handle});
+  linear.set_transform(0, twist(c, 1.0));
+  nonlinear.set_transform(0, twist(c, 1.0));
+  EXPECT_EQ(nonlinear.positions(), linear.positions());
+  EXPECT_NE(nonlinear.report().fallback.find("linear result"), std::string::npos)
+      << nonlinear.report().fallback;
+  EXPECT_TRUE(nonlinear.converged());
+}
+
+// A CAD tessellation of needles: the base is remeshed, so the nonlinear iteration sees no
+// needle; a 90° turn of a handle stays finite, keeps the fixed part and lowers the energy.
+TEST(Nonlinear, ANeedleCadMeshTurnsWithoutNan) {
+  for (const char* rel : {"cad/featuretype.STL", "cad/blade.off"}) {
+    const std::string path = std::string(REMORA_SHARED_DATA) + "/" + rel;
+    if (!std::filesystem::exists(path)) {
+      std::cout << path << " not present, skipped\n";
+      continue;
+    }
+    const Mesh mesh = read_mesh(path).mesh;
+    const BoundingBox box = bounding_box(mesh);
+    const Vec3 center = mesh.point(nearest_vertex(mesh, (box.min + box.max) * 0.5));
+    const auto support = select_sphere(mesh, center, 0.3 * box.diagonal());
+    const auto handle = select_sphere(mesh, center, 0.08 * box.diagonal());
+    Editor editor(mesh, nonlinear_options());
+    editor.set_region(support, {handle});
+    const Eigen::Vector3d c(center[0], center[1], center[2]);
+    editor.set_transform(
+        0, compose(translation({0, 0, 0.05 * box.diagonal()}), rotation({0, 0, 1}, kPi / 2, c)));
+    const Eigen::MatrixXd p = editor.positions();
+    EXPECT_TRUE(p.allFinite()) << rel;
+    for (const VertexHandle v : mesh.vertices())
+      if (!editor.in_support(v.idx())) {
+        EXPECT_EQ(p(v.idx(), 0), mesh.point(v)[0]) << rel;
+      }
+    const EditReport& r = editor.report();
+    EXPECT_TRUE(r.fallback.empty()) << rel << ": " << r.fallback;
+    expect_monotone(r.nonlinear.energy, rel);
+    std::cout << rel << ": " << r.free_base_vertices << " free base vertices, "
+              << r.nonlinear.iterations << " iterations, converged " << r.nonlinear.converged
+              << "\n";
+  }
+}
+
+// The deformer alone: the same minimizer from two different starts.
+TEST(NonlinearDeformer, ConvergesToTheSameShapeFromDifferentStarts) {
+  const Mesh m = make_cylinder(16, 24, 1.0, 2.0);
+  const Eigen::MatrixXd rest = positions_matrix(m);
+  std::vector<int> labels(m.n_vertices(), Region::kFree);
+  Eigen::MatrixXd weights = Eigen::MatrixXd::Zero(rest.rows(), 1);
+  for (int s = 0; s < 24; ++s) {
+    labels[static_cast<std::size_t>(s)] = Region::kFixed;
+    labels[static_cast<std::size_t>(16 * 24 + s)] = 0;
+  }
+  for (Eigen::Index v = 0; v < rest.rows(); ++v) weights(v, 0) = rest(v, 2) / 2.0;
+  NonlinearOptions o;
+  o.tolerance = 1e-9;
+  o.energy_tolerance = 0.0;
+  o.max_iterations = 2000;
+  const AffineMap t = rotation({0, 0, 1}, 1.2, {0, 0, 2});
+  RowPoints results[2];
+  for (int start = 0; start < 2; ++start) {
+    NonlinearDeformer d(m, rest, labels, weights, o);
+    RowPoints guess = rest;
+    for (Eigen::Index v = 0; v < rest.rows(); ++v) // a quarter of the twist, or a squeeze
+      guess.row(v) = start == 0
+                         ? Eigen::RowVector3d(
+                               Eigen::AngleAxisd(0.3 * rest(v, 2) / 2.0, Eigen::Vector3d::UnitZ()) *
+                               rest.row(v).transpose())
+                         : Eigen::RowVector3d(0.7 * rest(v, 0), 0.7 * rest(v, 1), rest(v, 2));
+    d.set_transforms({t}, &guess);
+    const NonlinearStats& s = d.solve();
+    EXPECT_TRUE(s.converged) << start;
+    results[start] = d.positions();
+  }
+  EXPECT_LT((results[0] - results[1]).rowwise().norm().maxCoeff(), 1e-6);
+}
+
+// The local step's rotation against the SVD's (the optimum of tr(R P)), from the identity, on
+// random full-rank and planar (rank 2) matrices; and never worse than its start.
+TEST(NonlinearDeformer, BestRotationMatchesTheSvdAndNeverLosesToItsStart) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  int close = 0;
+  for (int trial = 0; trial < 400; ++trial) {
+    Eigen::Matrix3d p;
+    for (int i = 0; i < 9; ++i) p(i / 3, i % 3) = u(rng);
+    if (trial % 2) p.col(2) = 0.3 * p.col(0) - 0.7 * p.col(1); // rank 2
+    const Eigen::JacobiSVD<Eigen::Matrix3d> svd(p, Eigen::ComputeFullU | Eigen::ComputeFullV);
+    Eigen::Matrix3d v = svd.matrixV();
+    if ((v * svd.matrixU().transpose()).determinant() < 0) v.col(2) = -v.col(2);
+    const double best = (v * svd.matrixU().transpose() * p).trace();
+    const Eigen::Matrix3d start =
+        Eigen::AngleAxisd(u(rng) * kPi, Eigen::Vector3d(u(rng), u(rng), u(rng)).normalized())
+            .toRotationMatrix();
+    const Eigen::Matrix3d r = best_rotation(p, start);
+    EXPECT_NEAR((r.transpose() * r - Eigen::Matrix3d::Identity()).norm(), 0.0, 1e-12);
+    EXPECT_NEAR(r.determinant(), 1.0, 1e-12);
+    EXPECT_GE((r * p).trace(), (start * p).trace() - 1e-12);
+    EXPECT_LE((r * p).trace(), best + 1e-12);
+    close += (r * p).trace() > best - 1e-9 ? 1 : 0;
+  }
+  EXPECT_GT(close, 385); // a few nearly degenerate draws need more than one call
+}
+
+TEST(NonlinearDeformer, RefusesMismatchedInput) {
+  const Mesh m = make_cylinder(4, 8, 1.0, 1.0);
+  const Eigen::MatrixXd rest = positions_matrix(m);
+  std::vector<int> labels(m.n_vertices(), Region::kFree);
+  labels[0] = 0;
+  const Eigen::MatrixXd weights = Eigen::MatrixXd::Zero(rest.rows(), 1);
+  EXPECT_THROW(NonlinearDeformer(m, rest.topRows(3), labels, weights), InvalidArgument);
+  EXPECT_THROW(NonlinearDeformer(m, rest, std::vector<int>(3, 0), weights), InvalidArgument);
+  NonlinearDeformer d(m, rest, labels, weights);
+  EXPECT_THROW(d.set_transforms({}), InvalidArgument);
+  EXPECT_THROW(parse_nonlinear_energy("elastic"), InvalidArgument);
+}
+
+} // namespace
+} // namespace remora
