@@ -343,13 +343,17 @@ void edit_seeds(const fs::path& out, const fs::path& repo) {
           "center": [0, 0, 1]}, "rotate": {"axis": [1, 0, 0], "degrees": 20, "center": [0, 0, 0]},
           "translate": [0, 0, 0.1]}}, {"region": [12, 10]}]})",
       R"({"k": 3, "details": "none", "support": {"vertices": [161, 160, 5]},
-          "handles": [{"region": {"union": [[5], {"vertices": [160]}]}}]})"};
+          "handles": [{"region": {"union": [[5], {"vertices": [160]}]}}]})",
+      R"({"method": "nonlinear", "k": 2, "support": {"sphere": {"center": [0, 0, 1],
+          "radius": 0.8}}, "handles": [{"region": {"sphere": {"center": [0, 0, 1], "radius":
+          0.2}}, "transform": {"rotate": {"axis": [0, 1, 0], "degrees": 90}}}]})"};
   for (const char* c : crafted)
     write(out / "edit_request", "crafted" + std::to_string(k++) + ".json", c);
 }
 
 /// Request scripts on the server harness's fixture: an edit round trip, a bake and undo through
-/// it, picks and views, a broken and a good upload, wrong methods and paths.
+/// it, picks and views, a broken and a good upload, wrong methods and paths, the nonlinear method
+/// with its relax steps.
 void server_seeds(const fs::path& out) {
   using R = fuzz::ScriptRequest;
   const std::string fixture = fuzz::server_fixture_off();
@@ -361,6 +365,11 @@ void server_seeds(const fs::path& out) {
   }
   const std::string region =
       nlohmann::json{{"support", support}, {"handles", {handle}}, {"k", 2}}.dump();
+  const std::string nonlinear = nlohmann::json{
+      {"support", support},
+      {"handles", {handle}},
+      {"k", 2},
+      {"method", "nonlinear"}}.dump();
   const std::string lift = R"({"handle": 0, "matrix": [1,0,0,0,0,1,0,0,0,0,1,0.3]})";
   const std::string twist = R"({"handle": 0, "matrix": [0.9,-0.1,0,0,0.1,0.9,0,0,0,0,1.2,0.1]})";
   const std::string pick = R"({"origin": [0.1, 0.2, 3], "direction": [0, 0, -1], "radius": 0.3})";
@@ -416,7 +425,16 @@ void server_seeds(const fs::path& out) {
        {"POST", "/api/region", {}, R"({"support": [1, 2)"},
        {"POST", "/api/transform", {}, R"({"handle": 0, "matrix": [1e400]})"},
        {"GET", "/api/status", {{"wait", "soon"}}, ""},
-       {"GET", "/api/export", {{"format", "doc"}}, ""}}};
+       {"GET", "/api/export", {{"format", "doc"}}, ""}},
+      {{"POST", "/api/region", {}, nonlinear},
+       {"POST", "/api/transform", {}, twist},
+       {"POST", "/api/relax", {}, R"({"budget_ms": 20})"},
+       {"POST", "/api/relax", {}, ""},
+       {"POST", "/api/relax", {}, R"({"budget_ms": 0})"},
+       {"GET", "/api/relax", {}, ""},
+       {"POST", "/api/region", {}, region},
+       {"POST", "/api/undo", {}, ""},
+       {"POST", "/api/region", {}, R"({"support": [1], "handles": [[1]], "method": "cubic"})"}}};
   int k = 0;
   for (const auto& script : scripts)
     write(out / "server", "script" + std::to_string(k++), fuzz::write_requests(script));

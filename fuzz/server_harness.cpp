@@ -28,9 +28,10 @@ bool is_json(const std::string& content_type) {
   return content_type.rfind("application/json", 0) == 0;
 }
 
-/// Float32 arrays that must be finite: positions and base positions and areas.
+/// Float32 arrays that must be finite: positions (of a move, a relax step, the mesh), base
+/// positions and areas.
 bool float_paths(const std::string& path) {
-  return path == "/api/transform" || path == "/api/mesh/positions" ||
+  return path == "/api/transform" || path == "/api/relax" || path == "/api/mesh/positions" ||
          path == "/api/base/positions" || path == "/api/base/areas";
 }
 
