@@ -37,6 +37,7 @@ import time
 
 DOCUMENTED = {200, 202, 400, 404, 405, 409, 413, 422}
 MAX_EDITORS = 3  # SessionOptions::max_editors, the editors the history keeps alive
+REGIONS_KEPT = 2  # the regions an editor keeps for an undo (multires/editor.h)
 
 
 class Violation(Exception):
@@ -201,6 +202,11 @@ class Soak:
             kind = rng.choices(["region", "transform", "commit", "undo", "redo", "load", "broken"],
                                [20, 40, 10, 8, 6, 2, 4])[0]
             if kind == "region":
+                # A region sent while a region job runs stops that job, which may or may not have
+                # installed its region by then; the replay could not tell, so regions wait for the
+                # previous region's job here (the stop is tested in test_server_editing.cpp).
+                if self.accepted and self.accepted[-1][1] == "/api/region":
+                    wait_idle(c)
                 method, path, body = "POST", "/api/region", self.region_body(rng)
             elif kind == "transform":
                 method, path, body = "POST", "/api/transform", self.transform_body(rng)
@@ -424,8 +430,8 @@ def main():
     with open(os.path.join(web_root, "index.html"), "w") as f:
         f.write("<html></html>\n")
 
-    # The memory bound's terms: an idle server, and what one editor of the mesh adds to it at
-    # most: a load, then the largest region (all of the mesh, k = 3, two handles).
+    # The memory bound's terms: an idle server, what a load of the mesh adds to it, and the
+    # largest region (all of the mesh, k = 3, two handles).
     server = Server(args.cli, None, args.upload_mb, web_root)
     idle_rss = server.rss_bytes()
     c = Client(server.port, Tally())
@@ -438,11 +444,14 @@ def main():
     c.request("POST", "/api/region", everything, "application/json")
     if "error" in wait_idle(c):
         raise RuntimeError("the calibration region failed")
-    editor_rss = server.rss_bytes() - idle_rss
+    region_rss = server.rss_bytes() - idle_rss - load_rss
     server.stop()
     upload = args.upload_mb * 1024 * 1024
-    # The history keeps MAX_EDITORS editors alive and a bake builds one more; each client can
-    # have one upload in flight, held by httplib, the request and the session (3 copies).
+    # The history keeps MAX_EDITORS editors alive and a bake builds one more; an editor holds its
+    # region, the REGIONS_KEPT it keeps for an undo and, during a region job, the one being
+    # prepared. Each client can have one upload in flight, held by httplib, the request and the
+    # session (3 copies).
+    editor_rss = load_rss + (REGIONS_KEPT + 2) * region_rss
     bound = idle_rss + (MAX_EDITORS + 1) * editor_rss + args.clients * 3 * upload
 
     server = Server(args.cli, args.mesh, args.upload_mb, web_root)
@@ -495,6 +504,7 @@ def main():
         "requests": soak.tally.counts,
         "accepted_state_changes": len(soak.accepted),
         "memory_mib": {"idle": round(idle_rss / 2**20, 1), "one_load": round(load_rss / 2**20, 1),
+                       "largest_region": round(region_rss / 2**20, 1),
                        "one_editor_at_most": round(editor_rss / 2**20, 1),
                        "bound": round(bound / 2**20, 1), "peak": round(peak / 2**20, 1),
                        "first_two_thirds_peak": round(early / 2**20, 1),
