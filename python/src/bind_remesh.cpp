@@ -72,7 +72,6 @@ py::tuple low_pass(const py::handle& vertices, const py::handle& faces, const py
   s["sigma_capped_vertices"] = stats.capped;
   s["sigma_capped_loops"] = stats.capped_loops;
   s["intrinsic_flips"] = stats.laplacian_stats.flips;
-  s["cg_iterations"] = stats.iterations;
   return py::make_tuple(rows_array(smooth), s);
 }
 
