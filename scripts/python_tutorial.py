@@ -6,7 +6,7 @@ picture the tutorial saves (python_tutorial.png) to --out.
     PYTHONPATH=build/python /usr/bin/python3 scripts/python_tutorial.py \\
         --out docs/images/python_tutorial.png
 
-`make pictures` runs it; the test Python.test_tutorial runs it with --out in a temporary folder.
+`make pictures` runs it; the test Python.test_docs runs it with --out in a temporary folder.
 """
 
 import argparse

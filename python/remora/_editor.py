@@ -45,13 +45,44 @@ class Editor:
 
     The mesh's connectivity never changes, and vertices outside the support keep their
     positions bit for bit. For the same mesh, region and transforms, :meth:`positions` is bit
-    for bit what ``remora edit`` writes.
+    for bit what ``remora edit`` writes (``remora edit --method nonlinear`` for
+    ``method="nonlinear"``).
+
+    How the base B follows the handles is ``method``:
+
+    - ``"linear"`` (the paper): the blend of the k-harmonic basis functions, exact for the
+      affine maps of the handles and free of iterations. A rotated handle does not rotate the
+      support: the support shears and shrinks, the known limit of linear variational
+      deformation (Botsch & Sorkine, "On linear variational surface deformation methods",
+      TVCG 2008, section 4).
+    - ``"nonlinear"``: starting from the linear result, B's free vertices minimize an energy
+      that is invariant under rotations of the rest shape's local pieces, by alternating a
+      local step (one best-fitting 3x3 rotation per vertex) and a global step (one sparse solve
+      with a matrix factored once per region), as in as-rigid-as-possible modelling (Sorkine &
+      Alexa 2007), with Anderson acceleration (Peng et al. 2018). The default energy rotates
+      B's Laplacian coordinates (a thin plate like k = 2) and adds the ARAP term that fixes the
+      rotations; ``"arap"`` alone is a membrane. Identity transforms give the input exactly,
+      and the details are decoded on the deformed B as for linear. src/remora/multires/nonlinear.h
+      states the energy.
 
     Args:
         V: (n, 3) float vertex positions, finite.
         F: (m, 3) integer vertex ids of a manifold, consistently oriented triangle mesh
             (:func:`remora.read_mesh` and :func:`remora.repair` give one).
         k: 1 (membrane), 2 (thin plate, the default) or 3 (minimum variation of curvature).
+        method: "linear" (the default, the paper) or "nonlinear" (large rotations, above);
+            :meth:`set_method` switches later.
+        nonlinear_options: a dict for method "nonlinear": ``energy`` ("rotated-laplacian", the
+            default, or "arap"), ``rigidity`` (100: the weight of the ARAP term against the
+            rotated Laplacian's, relative to the support's size), ``max_iterations`` (200, per
+            change of the transforms), ``tolerance`` (1e-4: converged when no free vertex
+            moves more than this times B's mean edge length in an iteration), and
+            ``energy_tolerance`` (1e-4: or when the energy falls by less than this fraction per
+            iteration over three), ``anderson`` (5: the acceleration's history; 0 = plain
+            iterations), ``preview_vertices`` (4000: a support of more than twice this many free
+            base vertices is iterated on a coarser remesh of B of about this many while
+            :meth:`positions` has a ``budget_ms``; 0 = never), ``solver`` (the global step's
+            factorization, a name of :func:`remora.solver_names`; default: the direct solver).
         **options: ``areas`` ("mean", the paper's symmetric system; "mixed"; "mixed-symmetric";
             docs/solvers.md), ``solver`` (a name of :func:`remora.solver_names` or "multigrid";
             default: the direct solver, "lu" for "mixed"), ``solver_options`` (a dict:
@@ -65,11 +96,23 @@ class Editor:
             ``threads`` (0 = all cores), ``progress`` (``f(phase, step, steps)``, called at the
             start of every phase of the preprocessing). docs/editing.md explains each.
 
-    Raises ValueError for bad arrays or options, RuntimeError when a solver fails.
+    Raises ValueError for bad arrays or options (the message names the option: ``Editor:
+    option method: unknown method ...``), RuntimeError when a solver fails.
     """
 
-    def __init__(self, V, F, k: int = 2, **options):
+    def __init__(
+        self,
+        V,
+        F,
+        k: int = 2,
+        method: str = "linear",
+        nonlinear_options: Optional[dict] = None,
+        **options,
+    ):
         options["k"] = k
+        options["method"] = method
+        if nonlinear_options is not None:
+            options["nonlinear_options"] = nonlinear_options
         self._editor = _remora.Editor(V, F, options)
 
     @property
@@ -116,15 +159,51 @@ class Editor:
         rotations and scalings (what ``remora edit --rotate`` turns about)."""
         return self._editor.handle_center(handle)
 
-    def positions(self, out: Optional[np.ndarray] = None) -> np.ndarray:
+    def positions(
+        self, out: Optional[np.ndarray] = None, *, budget_ms: Optional[float] = None
+    ) -> np.ndarray:
         """The mesh's vertex positions under the current transforms, (n, 3) float64.
 
         A new array, or ``out`` (a writeable C-contiguous (n, 3) float64 array) filled and
         returned, which saves the allocation in an interactive loop. Only the first call after a
-        :meth:`set_transform` computes (blend and decode, no solve). Raises ValueError before
-        :meth:`set_region`.
+        :meth:`set_transform` computes (blend and decode, no solve).
+
+        Method "nonlinear": with ``budget_ms=None`` (the default) the iteration runs until it
+        has converged (or reached ``max_iterations``), and the result is final. A number
+        (milliseconds of wall time, >= 0) bounds the iterations of this call (at least one),
+        for an interactive drag: each call goes on from the last one, and :attr:`converged`
+        says when the result is final. Method "linear" ignores ``budget_ms``.
+
+        Raises ValueError before :meth:`set_region` and for a negative or non-finite
+        ``budget_ms``.
         """
-        return self._editor.positions(out)
+        return self._editor.positions(out, budget_ms)
+
+    @property
+    def method(self) -> str:
+        """How the base follows the handles: "linear" or "nonlinear"."""
+        return self._editor.method()
+
+    def set_method(self, method: str) -> None:
+        """Switches between "linear" and "nonlinear", for the current region and the next ones.
+
+        Cheap: the next :meth:`positions` builds what "nonlinear" needs for the current region
+        (one factorization). The transforms stay. Raises ValueError (naming ``method``) for
+        another name.
+        """
+        self._editor.set_method(method)
+
+    @property
+    def converged(self) -> bool:
+        """Whether the last :meth:`positions` is final under the current transforms.
+
+        Always True for method "linear" and without a region. Method "nonlinear": True once the
+        iteration has converged, reached ``max_iterations`` or fallen back to the linear result
+        (``report()["nonlinear"]["fallback"]`` says why); False after a :meth:`set_transform`
+        until a :meth:`positions` has finished, and while calls with ``budget_ms`` are still
+        iterating.
+        """
+        return self._editor.converged()
 
     def movable_vertices(self) -> np.ndarray:
         """The vertices that move under the current region (the support), increasing ids."""
@@ -149,8 +228,12 @@ class Editor:
     def report(self) -> dict:
         """Figures and timings (docs/editing.md, "The report"): sizes of the input and base,
         the low-pass filter's sigma, the base's quality, the region on both meshes, the solver's
-        statistics, the Phong details, and wall times in milliseconds ("base", "remesh",
-        "set_region" and its parts, "frame": the last :meth:`positions` that had work)."""
+        statistics, the Phong details, ``method`` ("linear" or "nonlinear") and for
+        "nonlinear" a dict ``nonlinear`` (the last :meth:`positions`' ``iterations`` and those
+        since the last transform, ``accelerated``, ``converged``, ``last_move`` in B's mean
+        edge lengths, ``energy`` after each iterate, ``fallback``: why the linear result is
+        shown, or empty), and wall times in milliseconds ("base", "remesh", "set_region" and
+        its parts, "frame": the last :meth:`positions` that had work)."""
         return self._editor.report()
 
 

@@ -86,7 +86,8 @@ def low_pass(V, F, smoothing: float = 2.0, **options):
     ``threads``. docs/editing.md explains each.
 
     Returns (S, stats): S (n, 3) float64, the same connectivity F; stats a dict with ``sigma``,
-    ``sigma_min``, ``sigma_capped_vertices``, ``sigma_capped_loops`` and ``intrinsic_flips``. ``remora remesh --low-pass 2`` remeshes this S.
+    ``sigma_min``, ``sigma_capped_vertices``, ``sigma_capped_loops`` and ``intrinsic_flips``.
+    ``remora remesh --low-pass 2`` remeshes this S.
     """
     options["smoothing"] = smoothing
     return _remora.low_pass(V, F, options)

@@ -5,6 +5,7 @@
 // Python threads cannot enter one editor at once). The mutex is only ever waited for without the
 // GIL, so the two cannot deadlock.
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -16,8 +17,10 @@
 
 #include "bindings.h"
 #include "convert.h"
+#include "remora/linalg/solver.h"
 #include "remora/multires/edit_request.h"
 #include "remora/multires/editor.h"
+#include "remora/multires/nonlinear.h"
 
 namespace remora::python {
 
@@ -43,6 +46,50 @@ void apply_nested(const char* what, const py::handle& value, const OptionSetters
   apply_options(what, py::reinterpret_borrow<py::dict>(value), setters, options);
 }
 
+/// Number options with a bound; InvalidArgument "must be > 0, got 0" otherwise.
+double positive_real(const py::handle& value) {
+  const double x = option_real(value);
+  if (!(x > 0.0)) throw InvalidArgument(fmt::format("must be > 0, got {}", x));
+  return x;
+}
+double non_negative_real(const py::handle& value) {
+  const double x = option_real(value);
+  if (!(x >= 0.0)) throw InvalidArgument(fmt::format("must be >= 0, got {}", x));
+  return x;
+}
+int int_at_least(const py::handle& value, int low) {
+  const int x = option_int(value);
+  if (x < low) throw InvalidArgument(fmt::format("must be >= {}, got {}", low, x));
+  return x;
+}
+
+/// nonlinear_options={...}: the NonlinearOptions fields a Python caller may set (its threads
+/// are the editor's). The bounds are the deformer's: a value outside them would make every
+/// frame fall back to the linear result, so they are refused here, by name.
+const OptionSetters<NonlinearOptions>& nonlinear_setters() {
+  using O = NonlinearOptions;
+  static const OptionSetters<O> setters = {
+      {"energy",
+       [](O& o, const py::handle& v) { o.energy = parse_nonlinear_energy(option_string(v)); }},
+      {"rigidity", [](O& o, const py::handle& v) { o.rigidity = positive_real(v); }},
+      {"max_iterations", [](O& o, const py::handle& v) { o.max_iterations = int_at_least(v, 1); }},
+      {"tolerance", [](O& o, const py::handle& v) { o.tolerance = positive_real(v); }},
+      {"energy_tolerance",
+       [](O& o, const py::handle& v) { o.energy_tolerance = non_negative_real(v); }},
+      {"anderson", [](O& o, const py::handle& v) { o.anderson = int_at_least(v, 0); }},
+      {"preview_vertices",
+       [](O& o, const py::handle& v) { o.preview_vertices = int_at_least(v, 0); }},
+      {"solver",
+       [](O& o, const py::handle& v) {
+         SolverOptions solver = o.solver;
+         solver.name = option_string(v);
+         (void)make_solver(solver); // throws for a name this build does not have
+         o.solver = solver;
+       }},
+  };
+  return setters;
+}
+
 /// Editor(V, F, **options): one entry per EditorOptions field a Python caller may set (a new
 /// field is one more line here and in the docstring of python/remora/_editor.py).
 const OptionSetters<EditorOptions>& editor_setters() {
@@ -58,6 +105,11 @@ const OptionSetters<EditorOptions>& editor_setters() {
        }},
       {"details",
        [](O& o, const py::handle& v) { o.details = parse_detail_mode(option_string(v)); }},
+      {"method", [](O& o, const py::handle& v) { o.method = parse_edit_method(option_string(v)); }},
+      {"nonlinear_options",
+       [](O& o, const py::handle& v) {
+         apply_nested("nonlinear_options", v, nonlinear_setters(), o.nonlinear);
+       }},
       {"remesh", bool_field(&O::remesh)},
       {"base_smoothing", [](O& o, const py::handle& v) { o.base.smoothing = option_real(v); }},
       {"base_feature_cap", [](O& o, const py::handle& v) { o.base.feature_cap = option_real(v); }},
@@ -141,7 +193,32 @@ public:
     locked([&] { editor_->set_transform(handle, t); });
   }
 
-  py::array_t<double> positions(const py::handle& out) {
+  void set_method(const std::string& name) {
+    EditMethod method = EditMethod::Linear;
+    try {
+      method = parse_edit_method(name);
+    } catch (const InvalidArgument& e) {
+      throw InvalidArgument(fmt::format("method: {}", e.what()));
+    }
+    locked([&] { editor_->set_method(method); });
+  }
+
+  std::string method() {
+    return locked([&] { return to_string(editor_->options().method); });
+  }
+
+  bool converged() {
+    return locked([&] { return editor_->converged(); });
+  }
+
+  py::array_t<double> positions(const py::handle& out, const py::handle& budget) {
+    double budget_ms = std::numeric_limits<double>::infinity();
+    if (!budget.is_none()) {
+      budget_ms = real_arg(budget, "budget_ms");
+      if (!(budget_ms >= 0.0))
+        throw InvalidArgument(fmt::format(
+            "budget_ms: must be >= 0, got {} (None: iterate until converged)", budget_ms));
+    }
     const auto n = static_cast<py::ssize_t>(n_vertices());
     py::array_t<double> result;
     if (out.is_none()) {
@@ -158,7 +235,7 @@ public:
     }
     double* target = result.mutable_data();
     locked([&] {
-      const Eigen::MatrixXd& p = editor_->positions();
+      const Eigen::MatrixXd& p = editor_->positions(budget_ms);
       Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>>(target, n, 3) = p;
     });
     return result;
@@ -236,7 +313,10 @@ void bind_editor(py::module_& m) {
       .def_property_readonly("n_vertices", &PyEditor::n_vertices)
       .def("set_region", &PyEditor::set_region, py::arg("support"), py::arg("handles"))
       .def("set_transform", &PyEditor::set_transform, py::arg("handle"), py::arg("T"))
-      .def("positions", &PyEditor::positions, py::arg("out"))
+      .def("positions", &PyEditor::positions, py::arg("out"), py::arg("budget_ms"))
+      .def("set_method", &PyEditor::set_method, py::arg("method"))
+      .def("method", &PyEditor::method)
+      .def("converged", &PyEditor::converged)
       .def("base", &PyEditor::base)
       .def("base_positions", &PyEditor::base_positions)
       .def("low_pass", &PyEditor::low_pass, py::arg("values"))

@@ -10,6 +10,7 @@
 
 #include "remora/common/error.h"
 #include "remora/geometry/measures.h"
+#include "remora/geometry/per_face.h"
 
 namespace remora {
 namespace {

@@ -1,4 +1,5 @@
 #include "remora/geometry/measures.h"
+#include "remora/geometry/per_face.h"
 
 #include <algorithm>
 #include <cmath>

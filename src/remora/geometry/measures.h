@@ -10,7 +10,6 @@
 
 #include <Eigen/Core>
 
-#include "remora/common/parallel.h"
 #include "remora/mesh/mesh.h"
 
 namespace remora {
@@ -41,19 +40,6 @@ std::array<double, 3> triangle_angles(const Vec3& a, const Vec3& b, const Vec3& 
 /// The three parts sum to the triangle's area to round-off. A zero-area triangle gives (0, 0, 0);
 /// each part is clamped to [0, area], where it lies mathematically, so needles stay finite.
 std::array<double, 3> triangle_mixed_areas(const Vec3& a, const Vec3& b, const Vec3& c);
-
-/// value(f) for every face f, by idx() (T{} for a deleted face), computed on all hardware threads.
-/// `value` must only read the mesh; the result does not depend on the number of threads, so
-/// sums taken over it in face order are the same bits as a sequential loop's.
-template <class T, class Value>
-std::vector<T> per_face(const Mesh& mesh, Value&& value) {
-  std::vector<T> out(mesh.n_faces());
-  parallel_for(out.size(), 0, [&](std::size_t i) {
-    const FaceHandle f(static_cast<int>(i));
-    if (!mesh.status(f).deleted()) out[i] = value(f);
-  });
-  return out;
-}
 
 /// Barycentric vertex areas: one third of the area of every incident face.
 Eigen::VectorXd vertex_areas_barycentric(const Mesh& mesh);

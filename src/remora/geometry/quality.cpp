@@ -9,6 +9,8 @@
 
 #include <nlohmann/json.hpp>
 
+#include "remora/geometry/per_face.h"
+
 namespace remora {
 namespace {
 

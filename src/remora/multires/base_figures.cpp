@@ -8,6 +8,7 @@
 
 #include "remora/geometry/laplacian.h"
 #include "remora/geometry/measures.h"
+#include "remora/geometry/per_face.h"
 #include "remora/mesh/surface_point.h"
 
 namespace remora {
