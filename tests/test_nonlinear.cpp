@@ -21,6 +21,7 @@
 #include "remora/mesh/io.h"
 #include "remora/mesh/primitives.h"
 #include "remora/multires/editor.h"
+#include "remora/multires/rotation_blend.h"
 
 namespace remora {
 namespace {
@@ -373,6 +374,115 @@ TEST(Nonlinear, ANeedleCadMeshTurnsWithoutNan) {
               << r.nonlinear.iterations << " iterations, converged " << r.nonlinear.converged
               << "\n";
   }
+}
+
+// Propagated rotations (NonlinearEnergy::PropagatedRotations): one solve, no iteration. Exact
+// at the identity and for one rigid motion of every constraint (the weights then sum to 1, so
+// every vertex gets that rotation); is the linear method on a flat support; keeps the cylinder's bumps, and its rings as measured (docs/editing.md).
+EditorOptions propagated_options() {
+  EditorOptions o = nonlinear_options();
+  o.nonlinear.energy = NonlinearEnergy::PropagatedRotations;
+  return o;
+}
+
+TEST(NonlinearPropagated, IsExactForTheIdentityAndForOneRigidMotion) {
+  Mesh sphere = make_icosphere(3, 1.0);
+  for (const VertexHandle v : sphere.vertices()) {
+    const Vec3 p = sphere.point(v);
+    sphere.set_point(v, p * (1.0 + 0.03 * std::sin(9 * p[0]) * std::sin(9 * p[1])));
+  }
+  std::vector<int> all(sphere.n_vertices());
+  for (std::size_t i = 0; i < all.size(); ++i) all[i] = static_cast<int>(i);
+  Editor editor(sphere, propagated_options());
+  editor.set_region(
+      all, {select_sphere(sphere, Vec3(0, 0, 1), 0.5), select_sphere(sphere, Vec3(0, 0, -1), 0.5)});
+  const Eigen::MatrixXd rest = editor.base_positions();
+  const double diagonal = bounding_box_diagonal(sphere);
+  const Transform rigid =
+      compose(translation({0.4, -0.2, 1.5}), rotation({1, 2, 3}, 2.0, {0.1, 0.2, 0.3}));
+  editor.set_transform(0, rigid);
+  editor.set_transform(1, rigid);
+  const Eigen::MatrixXd moved =
+      ((rigid.leftCols<3>() * rest.transpose()).colwise() + rigid.col(3)).transpose();
+  EXPECT_LT(max_row_distance(editor.base_positions(), moved), 1e-9 * diagonal);
+  EXPECT_EQ(editor.report().nonlinear.total_iterations, 1);
+  EXPECT_TRUE(editor.converged());
+  // A different motion of one handle moves the result away; the identity brings it back exactly.
+  editor.set_transform(0, identity_transform());
+  EXPECT_GT(max_row_distance(editor.base_positions(), rest), 0.1 * diagonal);
+  editor.set_transform(1, identity_transform());
+  EXPECT_EQ(editor.base_positions(), rest);
+}
+
+TEST(NonlinearPropagated, KeepsTheCylindersBumpsAndBeatsTheLinearMethod) {
+  const Cylinder c = bumpy_cylinder();
+  Editor linear(c.mesh), propagated(c.mesh, propagated_options());
+  linear.set_region(c.support, {c.handle});
+  propagated.set_region(c.support, {c.handle});
+  for (const bool twisted : {true, false}) {
+    const Transform t = twisted ? twist(c, kPi / 2) : bend(c, kPi / 2);
+    linear.set_transform(0, t);
+    propagated.set_transform(0, t);
+    const Rings l = rings(c, linear.positions()), p = rings(c, propagated.positions());
+    std::cout << (twisted ? "twist" : "bend") << " 90 deg, propagated rotations: radius error "
+              << p.worst_radius_error << ", bumps " << p.amplitude << "\n";
+    // Measured 0.067 (twist) and 0.033 (bend): the rotations' variation along the axis shrinks
+    // the rings (docs/editing.md, "Large rotations").
+    EXPECT_LT(p.worst_radius_error, twisted ? 0.08 : 0.045);
+    EXPECT_LT(p.worst_radius_error, 0.4 * l.worst_radius_error);
+    EXPECT_GT(p.amplitude, 0.95);
+    EXPECT_LT(p.amplitude, 1.05);
+    EXPECT_EQ(propagated.report().nonlinear.iterations, 1);
+    expect_monotone(propagated.report().nonlinear.energy, "one solve");
+  }
+}
+
+// On a flat support δ = W x⁰ is 0 and so is every rotated target: the system is the linear
+// method's k = 2 fill, and small bending motions (a lift, a tilt) agree with it to round-off,
+// more than the second order of the iterative energies.
+TEST(NonlinearPropagated, OnAFlatSupportIsTheLinearMethod) {
+  const Mesh disc = make_disc(24, 6, 1.0);
+  std::vector<int> support, handle;
+  for (const VertexHandle v : disc.vertices()) {
+    const double r = disc.point(v).norm();
+    if (r < 0.9) support.push_back(v.idx());
+    if (r < 0.2) handle.push_back(v.idx());
+  }
+  Editor linear(disc), propagated(disc, propagated_options());
+  linear.set_region(support, {handle});
+  propagated.set_region(support, {handle});
+  const Eigen::MatrixXd rest = linear.base_positions();
+  for (const Transform& t : {translation({0, 0, 0.1}), rotation({1, 0, 0}, 0.1, {0, 0, 0}),
+                             rotation({1, 0, 0}, 1.0, {0, 0, 0})}) {
+    linear.set_transform(0, t);
+    propagated.set_transform(0, t);
+    const Eigen::MatrixXd a = linear.base_positions();
+    EXPECT_GT((a - rest).norm(), 0.05);
+    EXPECT_LT((propagated.base_positions() - a).norm(), 1e-9 * (a - rest).norm());
+  }
+}
+
+// The blend of the handles' rotations (multires/rotation_blend.h).
+TEST(RotationBlend, IsTheSlerpForOneHandleAndExactForAPartitionOfUnity) {
+  const Eigen::Vector3d axis = Eigen::Vector3d(1, -2, 0.5).normalized();
+  const Eigen::Matrix3d r = Eigen::AngleAxisd(2.5, axis).toRotationMatrix();
+  const Eigen::Matrix3d stretch = Eigen::Vector3d(1.5, 0.7, 1.1).asDiagonal();
+  const Eigen::Matrix3d m = r * stretch;
+  EXPECT_LT((polar_rotation(m) - r).norm(), 1e-12);
+  EXPECT_LT((polar_rotation(m) * polar_stretch(m) - m).norm(), 1e-12);
+  const std::vector<Eigen::Vector3d> one{rotation_log(r)};
+  for (const double w : {0.0, 0.3, 1.0}) {
+    const Eigen::Matrix3d b = blend_rotations(one, Eigen::RowVectorXd::Constant(1, w));
+    EXPECT_LT((b - Eigen::AngleAxisd(w * 2.5, axis).toRotationMatrix()).norm(), 1e-12) << w;
+  }
+  // The shorter way: a turn by 3π/2 is blended as one by −π/2.
+  const Eigen::Matrix3d long_turn = Eigen::AngleAxisd(1.5 * kPi, axis).toRotationMatrix();
+  EXPECT_LT((blend_rotations({rotation_log(long_turn)}, Eigen::RowVectorXd::Constant(1, 0.5)) -
+             Eigen::AngleAxisd(-0.25 * kPi, axis).toRotationMatrix())
+                .norm(),
+            1e-12);
+  const Eigen::RowVector2d weights(0.25, 0.75);
+  EXPECT_LT((blend_rotations({one[0], one[0]}, weights) - r).norm(), 1e-12);
 }
 
 // The deformer alone: the same minimizer from two different starts.

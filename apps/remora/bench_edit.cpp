@@ -27,7 +27,7 @@ namespace {
 struct BenchEditArgs {
   std::string mesh = std::string(REMORA_REPO_DATA) + "/bunny.ply";
   int support = 31000, frames = 60, k = 2, threads = 0;
-  std::string solver, method = "linear";
+  std::string solver, method = "linear", energy = "rotated-laplacian";
   double frame_budget_ms = 6.0;
   bool json = false;
 };
@@ -139,6 +139,7 @@ void run_bench_edit(const BenchEditArgs& a) {
   options.solver.name = a.solver;
   options.threads = a.threads;
   options.method = parse_edit_method(a.method);
+  options.nonlinear.energy = parse_nonlinear_energy(a.energy);
   ProgressLine progress;
   options.progress = [&](std::string_view phase, int step, int steps) {
     progress.update(phase, step, steps);
@@ -180,6 +181,9 @@ void add_bench_edit_command(CLI::App& bench) {
   cmd->add_option("--solver", a->solver, "Solver (default: the direct one)");
   cmd->add_option("--method", a->method, "linear (default) or nonlinear")
       ->check(CLI::IsMember({"linear", "nonlinear"}));
+  cmd->add_option("--energy", a->energy,
+                  "Nonlinear: rotated-laplacian (default), propagated or arap (docs/editing.md)")
+      ->check(CLI::IsMember({"rotated-laplacian", "propagated", "arap"}));
   cmd->add_option("--frame-budget", a->frame_budget_ms,
                   "Nonlinear: milliseconds of iterations per frame while dragging (default 6)")
       ->check(CLI::PositiveNumber);

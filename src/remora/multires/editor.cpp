@@ -543,8 +543,9 @@ void Editor::Impl::build_nonlinear(RegionState& r, EditReport& into) {
   NonlinearOptions o = options.nonlinear;
   o.threads = options.threads;
   const std::size_t n_free = r.free_vertices.size();
-  const bool preview =
-      o.preview_vertices > 0 && n_free > 2 * static_cast<std::size_t>(o.preview_vertices);
+  // Propagated rotations take one solve per frame: no preview.
+  const bool preview = o.energy != NonlinearEnergy::PropagatedRotations && o.preview_vertices > 0 &&
+                       n_free > 2 * static_cast<std::size_t>(o.preview_vertices);
   if (preview) {
     const double wanted = coarse_length(mean_edge_length(base), n_free, o);
     r.coarse = coarse;

@@ -15,6 +15,7 @@
 #include "remora/common/timer.h"
 #include "remora/geometry/laplacian.h"
 #include "remora/geometry/measures.h"
+#include "remora/multires/rotation_blend.h"
 
 namespace remora {
 
@@ -34,12 +35,6 @@ Matrix3 best_rotation_svd(const Matrix3& p) {
     r = v * svd.matrixU().transpose();
   }
   return r;
-}
-
-/// The symmetric factor S of the polar decomposition M = R S (S = V Σ Vᵀ).
-Matrix3 stretch_of(const Matrix3& m) {
-  const Eigen::JacobiSVD<Matrix3> svd(m, Eigen::ComputeFullU | Eigen::ComputeFullV);
-  return svd.matrixV() * svd.singularValues().asDiagonal() * svd.matrixV().transpose();
 }
 
 bool is_identity(const AffineMap& t) {
@@ -100,19 +95,29 @@ EditMethod parse_edit_method(const std::string& name) {
 }
 
 std::string to_string(NonlinearEnergy energy) {
-  return energy == NonlinearEnergy::Arap ? "arap" : "rotated-laplacian";
+  switch (energy) {
+  case NonlinearEnergy::Arap:
+    return "arap";
+  case NonlinearEnergy::RotatedLaplacian:
+    return "rotated-laplacian";
+  case NonlinearEnergy::PropagatedRotations:
+    break;
+  }
+  return "propagated";
 }
 
 NonlinearEnergy parse_nonlinear_energy(const std::string& name) {
   if (name == "arap") return NonlinearEnergy::Arap;
   if (name == "rotated-laplacian") return NonlinearEnergy::RotatedLaplacian;
-  throw InvalidArgument(
-      fmt::format("unknown nonlinear energy '{}': use rotated-laplacian or arap", name));
+  if (name == "propagated") return NonlinearEnergy::PropagatedRotations;
+  throw InvalidArgument(fmt::format(
+      "unknown nonlinear energy '{}': use propagated, rotated-laplacian or arap", name));
 }
 
 struct NonlinearDeformer::Impl {
   NonlinearOptions options;
   double a = 1.0, beta = 1.0; // the energy's weights
+  bool propagated = false;    // PropagatedRotations: β = 0, the rotations fixed by the handles
   std::size_t n = 0;
   std::vector<int> labels;
   std::vector<int> free_vertices, row_of; // row_of: vertex -> free row or -1
@@ -216,6 +221,31 @@ struct NonlinearDeformer::Impl {
     return e;
   }
 
+  /// Σ_m a ‖(W x)_m − R_m S_m δ_m‖² at the current x for the current rotations (the energy
+  /// PropagatedRotations minimizes; β = 0).
+  double fixed_rotation_energy() const {
+    std::vector<double> cell_energy(cells.size());
+    parallel_for(cells.size(), options.threads, [&](std::size_t c) {
+      Vector3 d = delta.row(static_cast<Eigen::Index>(c)).transpose();
+      if (stretched) d = stretch[c] * d;
+      cell_energy[c] = a * (laplacian(x, c) - rotation[c] * d).squaredNorm();
+    });
+    double e = 0.0;
+    for (const double v : cell_energy) e += v;
+    return e;
+  }
+
+  /// PropagatedRotations: each cell's rotation, the handles' rotations blended by its weights
+  /// (multires/rotation_blend.h).
+  void propagate_rotations(const std::vector<AffineMap>& transforms) {
+    std::vector<Vector3> logs;
+    for (const AffineMap& t : transforms)
+      logs.push_back(rotation_log(polar_rotation(t.leftCols<3>())));
+    parallel_for(cells.size(), options.threads, [&](std::size_t c) {
+      rotation[c] = blend_rotations(logs, weights.row(cells[c]));
+    });
+  }
+
   /// Global step: the free positions minimizing E for the rotations `rot`, as a vector.
   Eigen::VectorXd global_step(const std::vector<Matrix3>& rot) const {
     // t_m = R_m S_m δ_m per cell.
@@ -293,7 +323,7 @@ void NonlinearDeformer::Impl::build(const Mesh& base, const Eigen::MatrixXd& res
   }
   // β = rigidity × (mean vertex area) / (the support's area) = rigidity / n_free: the two terms
   // keep their ratio when the base is refined or the shape scaled (docs/editing.md).
-  if (a > 0.0) beta = options.rigidity / static_cast<double>(free_vertices.size());
+  if (a > 0.0 && !propagated) beta = options.rigidity / static_cast<double>(free_vertices.size());
   std::vector<char> in_cell(n, 0);
   for (const int v : free_vertices)
     for (SparseMatrix::InnerIterator it(w, v); it; ++it)
@@ -410,6 +440,16 @@ Eigen::VectorXd NonlinearDeformer::Impl::anderson(const Eigen::VectorXd& g,
 void NonlinearDeformer::Impl::iterate() {
   const Eigen::VectorXd u = free_vector();
   const double before = current_energy;
+  if (propagated) { // the rotations are fixed: one solve is the minimizer
+    set_free(global_step(rotation));
+    current_energy = fixed_rotation_energy();
+    stats.last_move = max_move(free_vector(), u) / edge_length;
+    stats.energy.push_back(current_energy);
+    ++stats.iterations;
+    ++stats.total_iterations;
+    stats.converged = true;
+    return;
+  }
   const Eigen::VectorXd g = global_step(rotation);
   const Eigen::VectorXd f = g - u;
   std::vector<Matrix3> rot(cells.size());
@@ -472,8 +512,9 @@ NonlinearDeformer::NonlinearDeformer(const Mesh& base, const Eigen::MatrixXd& re
   m.options = options;
   m.labels = labels;
   m.weights = handle_weights;
-  m.a = options.energy == NonlinearEnergy::RotatedLaplacian ? 1.0 : 0.0;
-  m.beta = options.energy == NonlinearEnergy::RotatedLaplacian ? options.rigidity : 1.0;
+  m.propagated = options.energy == NonlinearEnergy::PropagatedRotations;
+  m.a = options.energy == NonlinearEnergy::Arap ? 0.0 : 1.0;
+  m.beta = options.energy == NonlinearEnergy::Arap ? 1.0 : 0.0; // RotatedLaplacian: set by build()
   try {
     m.build(base, rest);
   } catch (const NumericalError& e) {
@@ -529,7 +570,7 @@ void NonlinearDeformer::set_transforms(const std::vector<AffineMap>& transforms,
   std::vector<Matrix3> handle_stretch;
   m.stretched = false;
   for (const AffineMap& t : transforms) {
-    handle_stretch.push_back(stretch_of(t.leftCols<3>()));
+    handle_stretch.push_back(polar_stretch(t.leftCols<3>()));
     if (!(handle_stretch.back() - Matrix3::Identity()).isZero(1e-12)) m.stretched = true;
   }
   for (std::size_t c = 0; c < m.cells.size(); ++c) {
@@ -548,6 +589,15 @@ void NonlinearDeformer::set_transforms(const std::vector<AffineMap>& transforms,
     m.stretch[c] = s + (1.0 - total) * Matrix3::Identity();
   }
   m.update_constrained_rhs();
+  if (m.propagated) { // the rotations from the handles; the start is the guess
+    m.propagate_rotations(transforms);
+    if (guess)
+      for (const int v : m.free_vertices) m.x.row(v) = guess->row(v);
+    m.current_energy = m.fixed_rotation_energy();
+    m.stats.energy.push_back(m.current_energy);
+    m.stats.converged = false;
+    return;
+  }
   // Start from the lowest-energy of: the guess, and the current free positions moved as the
   // guess moved since the last call (a predictor along a drag); without a guess, the current
   // positions.

@@ -17,8 +17,13 @@
 //   Energy::RotatedLaplacian a = 1: rotated Laplacian coordinates (the thin plate's W², as the
 //                           k = 2 system) plus the ARAP term that fixes the rotations; global
 //                           matrix W² − 2βW.
-// Each local step minimizes E over R exactly and each global step over x exactly (the matrix is
-// positive definite), so E never increases. Anderson acceleration (Peng et al. 2018) extrapolates
+//   Energy::PropagatedRotations a = 1, β = 0, and no local step: R_m is the handles' rotations
+//                           (polar parts of their maps) blended by the handles' weights, the
+//                           identity taking the rest (multires/rotation_blend.h; Zayer et al.
+//                           2005, Lipman et al. 2004); x is one solve of the W² system for those
+//                           rotations, so a frame is one back-substitution and no iteration.
+// For the iterative energies (Arap, RotatedLaplacian) each local step minimizes E over R exactly
+// and each global step over x exactly (the matrix is positive definite), so E never increases. Anderson acceleration (Peng et al. 2018) extrapolates
 // from the last iterates and keeps an extrapolated step only when it lowers E.
 //
 // Exact cases: all transforms identity -> x⁰ bit for bit (no iteration); one rigid motion of
@@ -53,13 +58,15 @@ enum class EditMethod {
 std::string to_string(EditMethod method);
 EditMethod parse_edit_method(const std::string& name); ///< "linear", "nonlinear"
 
-enum class NonlinearEnergy { Arap, RotatedLaplacian };
+/// The energies above; PropagatedRotations is one solve, the others local/global iterations.
+enum class NonlinearEnergy { Arap, RotatedLaplacian, PropagatedRotations };
 
 struct NonlinearOptions {
   NonlinearEnergy energy = NonlinearEnergy::RotatedLaplacian;
   /// RotatedLaplacian: the ARAP term's weight β = rigidity / (number of free vertices), i.e.
   /// rigidity × mean vertex area / support area, so that the balance of the two terms does not
-  /// change when the base is refined or the shape scaled. Arap: β = 1.
+  /// change when the base is refined or the shape scaled. Arap: β = 1. PropagatedRotations: β = 0
+  /// (unused).
   double rigidity = 100.0;
   int max_iterations = 200; ///< since the last set_transforms()
   /// Converged when the largest move of a free vertex in an iteration is below this times the
@@ -71,7 +78,7 @@ struct NonlinearOptions {
   SolverOptions solver; ///< the global step's factorization (empty name: the default)
   /// The editor: a support of more than twice this many free base vertices is previewed while
   /// dragging on a coarse remesh of the base with about this many (multires/nonlinear_region.h);
-  /// 0 = never.
+  /// 0 = never. Not for PropagatedRotations (one solve per frame).
   int preview_vertices = 4000;
   int threads = 0; ///< 0 = all
 };
@@ -111,7 +118,8 @@ public:
   const RowPoints& positions() const;
   const std::vector<int>& free_vertices() const;
   const NonlinearStats& stats() const;
-  /// E at the current positions with the best rotations.
+  /// E at the current positions with the best rotations (PropagatedRotations: the propagated
+  /// ones).
   double energy() const;
 
 private:
@@ -125,6 +133,7 @@ private:
 Eigen::Matrix3d best_rotation(const Eigen::Matrix3d& p, const Eigen::Matrix3d& start);
 
 std::string to_string(NonlinearEnergy energy);
-NonlinearEnergy parse_nonlinear_energy(const std::string& name); ///< "arap", "rotated-laplacian"
+/// "arap", "rotated-laplacian", "propagated"
+NonlinearEnergy parse_nonlinear_energy(const std::string& name);
 
 } // namespace remora
