@@ -28,7 +28,7 @@ std::string error_of(const json& j) {
 TEST(EditRequest, ParsesEveryRegionAndTransformForm) {
   const json j = json::parse(R"({
     "k": 3, "solver": "ldlt", "areas": "mixed-symmetric", "details": "none", "method": "nonlinear",
-    "remesh": false,
+    "energy": "blended-motions", "remesh": false,
     "base_smoothing": 1.5, "base_feature_cap": 0.5,
     "support": {"union": [[1, 2, 3], {"box": {"min": [0, 0, 0], "max": [1, 1, 1]}},
                           {"geodesic": {"vertex": 5, "radius": 0.5}}]},
@@ -53,6 +53,7 @@ TEST(EditRequest, ParsesEveryRegionAndTransformForm) {
   EXPECT_EQ(o.system.areas, AreaWeights::MixedSymmetric);
   EXPECT_EQ(o.details, DetailMode::None);
   EXPECT_EQ(o.method, EditMethod::Nonlinear);
+  EXPECT_EQ(o.nonlinear.energy, NonlinearEnergy::BlendedMotions);
   EXPECT_FALSE(o.remesh);
   EXPECT_EQ(o.base.smoothing, 1.5);
   EXPECT_EQ(o.base.feature_cap, 0.5);
@@ -99,6 +100,10 @@ TEST(EditRequest, ErrorsNameTheJsonPath) {
             std::string::npos);
   EXPECT_NE(error_of({{"support", {1}}, {"handles", handles}, {"method", "arap"}})
                 .find("edit.method: unknown value 'arap' (allowed: linear, nonlinear)"),
+            std::string::npos);
+  EXPECT_NE(error_of({{"support", {1}}, {"handles", handles}, {"energy", "screw"}})
+                .find("edit.energy: unknown nonlinear energy 'screw': use rotated-laplacian, "
+                      "propagated, blended-motions or arap"),
             std::string::npos);
   EXPECT_NE(error_of({{"support", {{"sphere", {{"center", {0, 0, 0}}, {"radius", -1}}}}},
                       {"handles", handles}})

@@ -15,6 +15,7 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 
+#include "cylinder_support.h"
 #include "remora/common/error.h"
 #include "remora/geometry/measures.h"
 #include "remora/geometry/selection.h"
@@ -26,94 +27,12 @@
 namespace remora {
 namespace {
 
-constexpr double kPi = std::numbers::pi;
-
-/// An open cylinder of radius 1 and height 4 about the z axis with radial bumps of the given
-/// amplitude: 12 around, wavelength 0.5 along z (8 base edge lengths). The support is every
-/// circle but the bottom one, the handle the top circle.
-struct Cylinder {
-  int rings = 70, segments = 96;
-  double amplitude = 0.02, height = 4.0;
-  Mesh mesh;
-  std::vector<int> support, handle;
-  int id(int k, int s) const { return k * segments + s; }
-  double bump(int k, int s) const {
-    const double phi = 2.0 * kPi * (s + (k % 2 ? 0.5 : 0.0)) / segments;
-    return std::sin(12.0 * phi) * std::sin(2.0 * kPi * (height * k / rings) / 0.5);
-  }
-};
-
-Cylinder bumpy_cylinder(int rings = 70, int segments = 96) {
-  Cylinder c;
-  c.rings = rings;
-  c.segments = segments;
-  c.mesh = make_cylinder(rings, segments, 1.0, c.height);
-  for (int k = 0; k <= rings; ++k)
-    for (int s = 0; s < segments; ++s) {
-      const VertexHandle v(c.id(k, s));
-      Vec3 p = c.mesh.point(v);
-      const double r = 1.0 + c.amplitude * c.bump(k, s);
-      p[0] *= r;
-      p[1] *= r;
-      c.mesh.set_point(v, p);
-      if (k > 0) c.support.push_back(v.idx());
-      if (k == rings) c.handle.push_back(v.idx());
-    }
-  return c;
-}
-
-struct Rings {
-  double worst_radius_error = 0.0; ///< the largest |mean radius − 1| of a circle of the input
-  double amplitude = 0.0;          ///< the bumps' least-squares amplitude over the input's
-};
-
-/// Each circle of the input (k = 0 .. rings) in `p`: its mean distance from its centroid, and the
-/// bumps as the least-squares multiple of the input's pattern in the distances' deviations.
-Rings rings(const Cylinder& c, const Eigen::MatrixXd& p) {
-  Rings f;
-  double dot = 0.0, norm = 0.0;
-  for (int k = 0; k <= c.rings; ++k) {
-    Eigen::RowVector3d centre = Eigen::RowVector3d::Zero();
-    for (int s = 0; s < c.segments; ++s) centre += p.row(c.id(k, s));
-    centre /= c.segments;
-    std::vector<double> r;
-    double mean = 0.0;
-    for (int s = 0; s < c.segments; ++s) {
-      r.push_back((p.row(c.id(k, s)) - centre).norm());
-      mean += r.back() / c.segments;
-    }
-    f.worst_radius_error = std::max(f.worst_radius_error, std::abs(mean - 1.0));
-    for (int s = 0; s < c.segments; ++s) {
-      dot += (r[static_cast<std::size_t>(s)] - mean) * c.bump(k, s);
-      norm += c.bump(k, s) * c.bump(k, s);
-    }
-  }
-  f.amplitude = dot / (norm * c.amplitude);
-  return f;
-}
-
-Transform twist(const Cylinder& c, double radians) {
-  return rotation({0, 0, 1}, radians, {0, 0, c.height});
-}
-
-/// The top circle where bending the axis into an arc of length `height` that turns by `radians`
-/// about y puts it: turned by `radians`, its centre at the arc's end.
-Transform bend(const Cylinder& c, double radians) {
-  const double rho = c.height / radians;
-  Transform t = rotation({0, 1, 0}, radians, {0, 0, 0});
-  const Eigen::Vector3d end(rho * (1.0 - std::cos(radians)), 0.0, rho * std::sin(radians));
-  t.col(3) = end - t.leftCols<3>() * Eigen::Vector3d(0, 0, c.height);
-  return t;
-}
+using namespace cylinder_testing;
 
 EditorOptions nonlinear_options() {
   EditorOptions o;
   o.method = EditMethod::Nonlinear;
   return o;
-}
-
-double max_row_distance(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
-  return (a - b).rowwise().norm().maxCoeff();
 }
 
 void expect_monotone(const std::vector<double>& energy, const std::string& what) {

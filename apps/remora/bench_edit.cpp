@@ -182,8 +182,9 @@ void add_bench_edit_command(CLI::App& bench) {
   cmd->add_option("--method", a->method, "linear (default) or nonlinear")
       ->check(CLI::IsMember({"linear", "nonlinear"}));
   cmd->add_option("--energy", a->energy,
-                  "Nonlinear: rotated-laplacian (default), propagated or arap (docs/editing.md)")
-      ->check(CLI::IsMember({"rotated-laplacian", "propagated", "arap"}));
+                  "Nonlinear: rotated-laplacian (default), propagated, blended-motions or arap "
+                  "(docs/editing.md)")
+      ->check(CLI::IsMember(nonlinear_energy_names()));
   cmd->add_option("--frame-budget", a->frame_budget_ms,
                   "Nonlinear: milliseconds of iterations per frame while dragging (default 6)")
       ->check(CLI::PositiveNumber);

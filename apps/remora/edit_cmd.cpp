@@ -116,6 +116,8 @@ void print_edit_report(std::ostream& os, const EditReport& r, double load_ms, do
     const NonlinearStats& n = r.nonlinear;
     if (!r.fallback.empty())
       os << "deformation: nonlinear, " << r.fallback << "\n";
+    else if (r.nonlinear_energy == "blended-motions")
+      os << "deformation: nonlinear, blended-motions (closed form, no iteration)\n";
     else
       os << fmt::format("deformation: nonlinear, {} iterations ({} extrapolated), {}, energy "
                         "{:.4g} -> {:.4g}\n",
@@ -142,7 +144,7 @@ struct EditArgs {
   std::string in, out, edit;
   std::string support_sphere, handle_sphere, translate, rotate, scale;
   int k = 0, threads = 0;
-  std::string solver, areas, details, method;
+  std::string solver, areas, details, method, energy;
   double base_smoothing = -1, base_feature_cap = -1, length_factor = -1;
   bool no_remesh = false, report = false, json = false;
   std::uint64_t max_triangles = 0;
@@ -181,6 +183,10 @@ void add_edit_options(CLI::App* cmd, EditArgs& a) {
   cmd->add_option("--method", a.method,
                   "linear (default, the paper) or nonlinear (keeps rotated parts from shrinking)")
       ->check(CLI::IsMember({"linear", "nonlinear"}));
+  cmd->add_option("--energy", a.energy,
+                  "Method nonlinear: rotated-laplacian (default), propagated, blended-motions or "
+                  "arap (docs/editing.md, \"Large rotations\")")
+      ->check(CLI::IsMember(nonlinear_energy_names()));
   cmd->add_option("--base-smoothing", a.base_smoothing,
                   "Low-pass length of the base surface, in mean edge lengths (area-based on needle "
                   "meshes; default 2)")
@@ -260,6 +266,7 @@ EditorOptions editor_options(const EditRequest& request, const EditArgs& a) {
   if (!a.areas.empty()) options.system.areas = parse_area_weights(a.areas);
   if (!a.details.empty()) options.details = parse_detail_mode(a.details);
   if (!a.method.empty()) options.method = parse_edit_method(a.method);
+  if (!a.energy.empty()) options.nonlinear.energy = parse_nonlinear_energy(a.energy);
   if (a.base_smoothing >= 0) options.base.smoothing = a.base_smoothing;
   if (a.base_feature_cap >= 0) options.base.feature_cap = a.base_feature_cap;
   if (a.length_factor > 0) options.remesh_options.length_factor = a.length_factor;

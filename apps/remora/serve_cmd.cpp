@@ -33,7 +33,7 @@ void stop_on_signal(int) {
 void add_serve_command(CLI::App& app) {
   auto* cmd = app.add_subcommand("serve", "The editor in the browser: serves the page and its API");
   struct Args {
-    std::string mesh, host = "127.0.0.1", web_root = REMORA_WEB_ROOT;
+    std::string mesh, host = "127.0.0.1", web_root = REMORA_WEB_ROOT, energy;
     int port = 8080, threads = 0, max_handles = kMaxHandles, history_editors = 3;
     double max_upload_mb = 256, frame_budget_ms = 6.0;
     std::uint64_t max_triangles = 0;
@@ -51,6 +51,10 @@ void add_serve_command(CLI::App& app) {
   cmd->add_option("--frame-budget", a->frame_budget_ms,
                   "Method nonlinear: milliseconds of iterations per handle move (default 6)")
       ->check(CLI::PositiveNumber);
+  cmd->add_option("--energy", a->energy,
+                  "Method nonlinear: rotated-laplacian (default), propagated, blended-motions or "
+                  "arap (docs/editing.md, \"Large rotations\")")
+      ->check(CLI::IsMember(nonlinear_energy_names()));
   cmd->add_option("--history-editors", a->history_editors,
                   "Editors (one per bake) the undo history keeps alive (default 3); fewer raise "
                   "the default --max-triangles")
@@ -75,6 +79,7 @@ void add_serve_command(CLI::App& app) {
     options.read.max_triangles = a->max_triangles;
     options.max_handles = a->max_handles;
     options.frame_budget_ms = a->frame_budget_ms;
+    if (!a->energy.empty()) options.editor.nonlinear.energy = parse_nonlinear_energy(a->energy);
     server::Session session(options);
     server::ApiLimits limits;
     limits.max_upload_bytes = static_cast<std::size_t>(a->max_upload_mb * 1024 * 1024);

@@ -115,6 +115,23 @@ def test_nonlinear_options_reach_the_deformer(twisted):
     assert not np.array_equal(arap.positions(), P)
 
 
+def test_blended_motions_keep_every_ring_in_closed_form(twisted):
+    # The handles' screws blended by their weights: each ring moves rigidly, no iteration.
+    V, F, rings, T, _ = twisted
+    editor = remora.Editor(V, F, method="nonlinear",
+                           nonlinear_options={"energy": "blended-motions"})
+    editor.set_region(rings[1:].ravel(), [rings[-1]])
+    editor.set_transform(0, T)
+    P = editor.positions()
+    assert editor.converged
+    report = editor.report()
+    assert report["nonlinear"]["total_iterations"] == 0
+    assert report["nonlinear"]["energy_name"] == "blended-motions"
+    ring = P[rings]  # (rings, segments, 3)
+    radii = np.linalg.norm(ring[:, :, :2] - ring[:, :, :2].mean(axis=1, keepdims=True), axis=2)
+    assert np.abs(radii.mean(axis=1) - 1.0).max() < 0.02
+
+
 def test_the_identity_gives_the_input(bunny):
     V = bunny.V
     support = remora.select_sphere(V, *EAR_SUPPORT)

@@ -183,7 +183,7 @@ TransformSpec parse_transform(const json& j, const std::string& path) {
 EditRequest parse_edit_request(const json& j) {
   EditRequest r;
   only_keys(j, "edit",
-            {"k", "solver", "areas", "details", "method", "remesh", "base_smoothing",
+            {"k", "solver", "areas", "details", "method", "energy", "remesh", "base_smoothing",
              "base_feature_cap", "support", "handles"});
   if (j.contains("k")) {
     if (!j.at("k").is_number_integer()) fail("edit.k", "expected 1, 2 or 3");
@@ -196,6 +196,14 @@ EditRequest parse_edit_request(const json& j) {
   if (j.contains("details"))
     r.details = name(j.at("details"), "edit.details", {"normal", "displacement", "none"});
   if (j.contains("method")) r.method = name(j.at("method"), "edit.method", {"linear", "nonlinear"});
+  if (j.contains("energy")) {
+    r.energy = name(j.at("energy"), "edit.energy", {});
+    try {
+      parse_nonlinear_energy(*r.energy);
+    } catch (const InvalidArgument& e) {
+      fail("edit.energy", e.what());
+    }
+  }
   if (j.contains("remesh")) {
     if (!j.at("remesh").is_boolean()) fail("edit.remesh", "expected true or false");
     r.remesh = j.at("remesh").get<bool>();
@@ -319,6 +327,7 @@ void apply_request_options(const EditRequest& r, EditorOptions& o) {
   if (r.areas) o.system.areas = parse_area_weights(*r.areas);
   if (r.details) o.details = parse_detail_mode(*r.details);
   if (r.method) o.method = parse_edit_method(*r.method);
+  if (r.energy) o.nonlinear.energy = parse_nonlinear_energy(*r.energy);
   if (r.remesh) o.remesh = *r.remesh;
   if (r.base_smoothing) o.base.smoothing = *r.base_smoothing;
   if (r.base_feature_cap) o.base.feature_cap = *r.base_feature_cap;

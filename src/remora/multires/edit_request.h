@@ -58,7 +58,7 @@ struct HandleSpec {
 
 struct EditRequest {
   std::optional<int> k;
-  std::optional<std::string> solver, areas, details, method;
+  std::optional<std::string> solver, areas, details, method, energy;
   std::optional<bool> remesh;
   std::optional<double> base_smoothing, base_feature_cap;
   RegionSpec support;

@@ -543,8 +543,9 @@ void Editor::Impl::build_nonlinear(RegionState& r, EditReport& into) {
   NonlinearOptions o = options.nonlinear;
   o.threads = options.threads;
   const std::size_t n_free = r.free_vertices.size();
-  // Propagated rotations take one solve per frame: no preview.
-  const bool preview = o.energy != NonlinearEnergy::PropagatedRotations && o.preview_vertices > 0 &&
+  // Propagated rotations take one solve per frame, blended motions none: no preview.
+  const bool preview = o.energy != NonlinearEnergy::PropagatedRotations &&
+                       o.energy != NonlinearEnergy::BlendedMotions && o.preview_vertices > 0 &&
                        n_free > 2 * static_cast<std::size_t>(o.preview_vertices);
   if (preview) {
     const double wanted = coarse_length(mean_edge_length(base), n_free, o);
@@ -572,6 +573,7 @@ void Editor::Impl::deform_base(RegionState& r, bool moved, double budget_ms) {
   r.nonlinear->frame(r.transforms, moved, budget_ms, positions);
   r.frame.leftCols<3>() = positions;
   report.method = "nonlinear";
+  report.nonlinear_energy = to_string(options.nonlinear.energy);
   report.nonlinear = r.nonlinear->stats();
   report.nonlinear_level = r.nonlinear->level();
   report.fallback = r.nonlinear->fallback();
@@ -877,10 +879,10 @@ nlohmann::json to_json(const EditReport& r) {
   j["method"] = r.method;
   if (r.method == "nonlinear") {
     const NonlinearStats& n = r.nonlinear;
-    j["nonlinear"] = {{"iterations", n.iterations},   {"total_iterations", n.total_iterations},
-                      {"accelerated", n.accelerated}, {"converged", n.converged},
-                      {"last_move", n.last_move},     {"energy", n.energy},
-                      {"fallback", r.fallback}};
+    j["nonlinear"] = {{"iterations", n.iterations},        {"total_iterations", n.total_iterations},
+                      {"accelerated", n.accelerated},      {"converged", n.converged},
+                      {"last_move", n.last_move},          {"energy", n.energy},
+                      {"energy_name", r.nonlinear_energy}, {"fallback", r.fallback}};
   }
   j["milliseconds"] = r.milliseconds;
   return j;

@@ -126,6 +126,8 @@ struct EditReport {
   /// The base's deformation in the last frame: "linear" or "nonlinear".
   std::string method = "linear";
   NonlinearStats nonlinear; ///< method nonlinear: the last frame's iterations
+  /// Method nonlinear: its energy's name (to_string(NonlinearEnergy)).
+  std::string nonlinear_energy;
   /// Method nonlinear: "coarse" when the last frame showed the preview of a large support,
   /// "fine" otherwise (multires/nonlinear_region.h).
   std::string nonlinear_level;

@@ -15,6 +15,7 @@
 #include "remora/common/timer.h"
 #include "remora/geometry/laplacian.h"
 #include "remora/geometry/measures.h"
+#include "remora/multires/motion_blend.h"
 #include "remora/multires/rotation_blend.h"
 
 namespace remora {
@@ -101,23 +102,35 @@ std::string to_string(NonlinearEnergy energy) {
   case NonlinearEnergy::RotatedLaplacian:
     return "rotated-laplacian";
   case NonlinearEnergy::PropagatedRotations:
+    return "propagated";
+  case NonlinearEnergy::BlendedMotions:
     break;
   }
-  return "propagated";
+  return "blended-motions";
 }
 
 NonlinearEnergy parse_nonlinear_energy(const std::string& name) {
   if (name == "arap") return NonlinearEnergy::Arap;
   if (name == "rotated-laplacian") return NonlinearEnergy::RotatedLaplacian;
   if (name == "propagated") return NonlinearEnergy::PropagatedRotations;
-  throw InvalidArgument(fmt::format(
-      "unknown nonlinear energy '{}': use propagated, rotated-laplacian or arap", name));
+  if (name == "blended-motions") return NonlinearEnergy::BlendedMotions;
+  throw InvalidArgument(fmt::format("unknown nonlinear energy '{}': use rotated-laplacian, "
+                                    "propagated, blended-motions or arap",
+                                    name));
+}
+
+const std::vector<std::string>& nonlinear_energy_names() {
+  static const std::vector<std::string> names{"rotated-laplacian", "propagated", "blended-motions",
+                                              "arap"};
+  return names;
 }
 
 struct NonlinearDeformer::Impl {
   NonlinearOptions options;
-  double a = 1.0, beta = 1.0; // the energy's weights
-  bool propagated = false;    // PropagatedRotations: β = 0, the rotations fixed by the handles
+  double a = 1.0, beta = 1.0;  // the energy's weights
+  bool propagated = false;     // PropagatedRotations: β = 0, the rotations fixed by the handles
+  bool blended = false;        // BlendedMotions: closed form, no system
+  std::vector<Vector3> pivots; // per handle: its rest centroid (BlendedMotions' stretch centre)
   std::size_t n = 0;
   std::vector<int> labels;
   std::vector<int> free_vertices, row_of; // row_of: vertex -> free row or -1
@@ -356,6 +369,19 @@ void NonlinearDeformer::Impl::build(const Mesh& base, const Eigen::MatrixXd& res
   stretch.assign(cells.size(), Matrix3::Identity());
   rotation.assign(cells.size(), Matrix3::Identity());
 
+  if (blended) { // no system: the handles' pivots
+    const auto h = static_cast<std::size_t>(weights.cols());
+    pivots.assign(h, Vector3::Zero());
+    std::vector<double> count(h, 0.0);
+    for (std::size_t v = 0; v < n; ++v)
+      if (labels[v] >= 0 && static_cast<std::size_t>(labels[v]) < h) {
+        pivots[static_cast<std::size_t>(labels[v])] += rest.row(static_cast<Eigen::Index>(v));
+        count[static_cast<std::size_t>(labels[v])] += 1.0;
+      }
+    for (std::size_t j = 0; j < h; ++j)
+      if (count[j] > 0.0) pivots[j] /= count[j];
+    return;
+  }
   // K = a (W²)_FF − 2β W_FF.
   const auto nfree = static_cast<Eigen::Index>(nf());
   SparseMatrix select(static_cast<Eigen::Index>(n), nfree);
@@ -387,6 +413,7 @@ void NonlinearDeformer::Impl::build(const Mesh& base, const Eigen::MatrixXd& res
 
 // −K_FC x_C = −a (W (W x̃))_F + 2β (W x̃)_F with x̃ the constrained values (free rows zero).
 void NonlinearDeformer::Impl::update_constrained_rhs() {
+  if (blended) return; // no system
   RowPoints xc = x;
   for (const int v : free_vertices) xc.row(v).setZero();
   RowPoints y(static_cast<Eigen::Index>(cells.size()), 3);
@@ -513,6 +540,7 @@ NonlinearDeformer::NonlinearDeformer(const Mesh& base, const Eigen::MatrixXd& re
   m.labels = labels;
   m.weights = handle_weights;
   m.propagated = options.energy == NonlinearEnergy::PropagatedRotations;
+  m.blended = options.energy == NonlinearEnergy::BlendedMotions;
   m.a = options.energy == NonlinearEnergy::Arap ? 0.0 : 1.0;
   m.beta = options.energy == NonlinearEnergy::Arap ? 1.0 : 0.0; // RotatedLaplacian: set by build()
   try {
@@ -565,6 +593,14 @@ void NonlinearDeformer::set_transforms(const std::vector<AffineMap>& transforms,
     } else if (label == Region::kFixed) {
       m.x.row(static_cast<Eigen::Index>(v)) = m.rest.row(static_cast<Eigen::Index>(v));
     }
+  }
+  if (m.blended) { // closed form: the result, no iteration
+    blend_motions(m.rest, m.weights, m.free_vertices, handle_motions(transforms, m.pivots), m.x,
+                  m.options.threads);
+    m.current_energy = 0.0;
+    m.previous_guess = m.free_vector();
+    m.stats.converged = true;
+    return;
   }
   // Stretches blended by the handle weights.
   std::vector<Matrix3> handle_stretch;

@@ -22,6 +22,10 @@
 //                           identity taking the rest (multires/rotation_blend.h; Zayer et al.
 //                           2005, Lipman et al. 2004); x is one solve of the W² system for those
 //                           rotations, so a frame is one back-substitution and no iteration.
+//   Energy::BlendedMotions  no energy and no system: the handles' whole rigid motions (screws)
+//                           blended by the same weights and applied to x⁰ in closed form
+//                           (multires/motion_blend.h); a twisted or bent tube keeps its
+//                           cross-sections, which no energy above does with the ends held.
 // For the iterative energies (Arap, RotatedLaplacian) each local step minimizes E over R exactly
 // and each global step over x exactly (the matrix is positive definite), so E never increases. Anderson acceleration (Peng et al. 2018) extrapolates
 // from the last iterates and keeps an extrapolated step only when it lowers E.
@@ -58,8 +62,9 @@ enum class EditMethod {
 std::string to_string(EditMethod method);
 EditMethod parse_edit_method(const std::string& name); ///< "linear", "nonlinear"
 
-/// The energies above; PropagatedRotations is one solve, the others local/global iterations.
-enum class NonlinearEnergy { Arap, RotatedLaplacian, PropagatedRotations };
+/// The energies above; PropagatedRotations is one solve, BlendedMotions a closed form, the others
+/// local/global iterations.
+enum class NonlinearEnergy { Arap, RotatedLaplacian, PropagatedRotations, BlendedMotions };
 
 struct NonlinearOptions {
   NonlinearEnergy energy = NonlinearEnergy::RotatedLaplacian;
@@ -133,7 +138,9 @@ private:
 Eigen::Matrix3d best_rotation(const Eigen::Matrix3d& p, const Eigen::Matrix3d& start);
 
 std::string to_string(NonlinearEnergy energy);
-/// "arap", "rotated-laplacian", "propagated"
+/// "arap", "rotated-laplacian", "propagated", "blended-motions"
 NonlinearEnergy parse_nonlinear_energy(const std::string& name);
+/// The names parse_nonlinear_energy() takes, the default first.
+const std::vector<std::string>& nonlinear_energy_names();
 
 } // namespace remora
