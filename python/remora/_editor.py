@@ -74,7 +74,8 @@ class Editor:
             :meth:`set_method` switches later.
         nonlinear_options: a dict for method "nonlinear": ``energy`` ("rotated-laplacian", the
             default, "propagated": the handles' rotations blended by their weights, one solve,
-            or "arap"), ``rigidity`` (100: the weight of the ARAP term against the
+            "blended-motions": the handles' rigid motions blended by their weights as screws,
+            in closed form, or "arap"), ``rigidity`` (100: the weight of the ARAP term against the
             rotated Laplacian's, relative to the support's size), ``max_iterations`` (200, per
             change of the transforms), ``tolerance`` (1e-4: converged when no free vertex
             moves more than this times B's mean edge length in an iteration), and

@@ -316,6 +316,22 @@ void NonlinearDeformer::Impl::build(const Mesh& base, const Eigen::MatrixXd& res
       free_vertices.push_back(static_cast<int>(v));
     }
   if (free_vertices.empty()) throw InvalidArgument("nonlinear deformer: no free vertex");
+  if (blended) { // no system: the handles' pivots
+    const auto h = static_cast<std::size_t>(weights.cols());
+    pivots.assign(h, Vector3::Zero());
+    std::vector<double> count(h, 0.0);
+    for (std::size_t v = 0; v < n; ++v)
+      if (labels[v] >= 0 && static_cast<std::size_t>(labels[v]) < h) {
+        pivots[static_cast<std::size_t>(labels[v])] +=
+            rest_positions.row(static_cast<Eigen::Index>(v));
+        count[static_cast<std::size_t>(labels[v])] += 1.0;
+      }
+    for (std::size_t j = 0; j < h; ++j)
+      if (count[j] > 0.0) pivots[j] /= count[j];
+    rest = rest_positions;
+    x = rest;
+    return;
+  }
   // The rest shape's own cotan weights (not B's: B0 can be far from B inside the support), with
   // negative ones clamped to 0 so that the global matrix stays positive definite.
   Mesh shape = base;
@@ -369,19 +385,6 @@ void NonlinearDeformer::Impl::build(const Mesh& base, const Eigen::MatrixXd& res
   stretch.assign(cells.size(), Matrix3::Identity());
   rotation.assign(cells.size(), Matrix3::Identity());
 
-  if (blended) { // no system: the handles' pivots
-    const auto h = static_cast<std::size_t>(weights.cols());
-    pivots.assign(h, Vector3::Zero());
-    std::vector<double> count(h, 0.0);
-    for (std::size_t v = 0; v < n; ++v)
-      if (labels[v] >= 0 && static_cast<std::size_t>(labels[v]) < h) {
-        pivots[static_cast<std::size_t>(labels[v])] += rest.row(static_cast<Eigen::Index>(v));
-        count[static_cast<std::size_t>(labels[v])] += 1.0;
-      }
-    for (std::size_t j = 0; j < h; ++j)
-      if (count[j] > 0.0) pivots[j] /= count[j];
-    return;
-  }
   // K = a (W²)_FF − 2β W_FF.
   const auto nfree = static_cast<Eigen::Index>(nf());
   SparseMatrix select(static_cast<Eigen::Index>(n), nfree);
