@@ -10,7 +10,7 @@
 //        [--only NAME[,NAME...]] [--cli build/bin/remora] [--web-root build/web]
 //
 // Pictures: bunny_ear, acrossriver_lift, base_area, needles_base, cylinder_twist and bunny_ear_twist
-// (the methods linear and nonlinear side by side; the bumpy cylinder is written by this script into
+// (the methods linear, nonlinear and blended motions side by side; the bumpy cylinder is written by this script into
 // the system's temporary folder). The shared meshes are read from
 // ../shared/data beside the repository (REMORA_DATA overrides); a missing one skips its picture
 // with a message. Each PNG is written to a temporary name and renamed, so none is ever partial.
@@ -93,9 +93,9 @@ const disc = (c, r) => (p) => (p[0] - c[0]) ** 2 + (p[1] - c[1]) ** 2 <= r * r; 
 const above = (z) => (p) => p[2] > z;
 
 // A picture: the mesh, an optional edit (a support and a handle as vertex predicates, the handle's
-// translation and rotation about its centroid, as `remora edit` does), and two panels, each a view
-// of the page (its URL options) before or after the edit (after it with the panel's method, linear
-// unless it says), side by side (row) or stacked (column).
+// translation and rotation about its centroid, as `remora edit` does), and two or three panels, each
+// a view of the page (its URL options) before or after the edit (after it with the panel's method
+// as the page's switch names it, linear unless it says), side by side (row) or stacked (column).
 const PICTURES = [
   {
     name: 'base_area', mesh: BUNNY, layout: 'row',
@@ -122,11 +122,13 @@ const PICTURES = [
   {
     name: 'cylinder_twist', mesh: CYLINDER, layout: 'row',
     edit: { support: above(0.01), handle: above(3.99), rotate: { axis: [0, 0, 1], degrees: 90 } },
-    caption: 'an open cylinder with bumps, everything but the bottom circle free, the top circle turned 90°',
+    caption: 'an open cylinder with bumps, everything but the bottom circle free, the top circle turned 90°; the worst circle\'s mean radius',
     panels: [
-      { label: 'linear: the middle shrinks to 0.80 of the radius', stage: 'after', method: 'linear',
+      { label: 'linear: 0.80', stage: 'after', method: 'linear',
         camera: [6.5, -6.5, 4.0, 0, 0, 1.9, 0, 0, 1] },
       { label: 'nonlinear: 0.94', stage: 'after', method: 'nonlinear',
+        camera: [6.5, -6.5, 4.0, 0, 0, 1.9, 0, 0, 1] },
+      { label: 'blended motions: 1.00', stage: 'after', method: 'blended-motions',
         camera: [6.5, -6.5, 4.0, 0, 0, 1.9, 0, 0, 1] },
     ],
   },
@@ -138,6 +140,7 @@ const PICTURES = [
     panels: [
       { label: 'linear', stage: 'after', method: 'linear', camera: [0.1, 0.2, 0.34, -0.02, 0.115, 0.0] },
       { label: 'nonlinear', stage: 'after', method: 'nonlinear', camera: [0.1, 0.2, 0.34, -0.02, 0.115, 0.0] },
+      { label: 'blended motions', stage: 'after', method: 'blended-motions', camera: [0.1, 0.2, 0.34, -0.02, 0.115, 0.0] },
     ],
   },
   {
@@ -403,8 +406,8 @@ async function main() {
     for (const picture of todo) {
       const started = Date.now();
       const horizontal = picture.layout === 'row';
-      const panelWidth = horizontal ? Math.floor(o.width / 2) : o.width;
-      const panelHeight = horizontal ? o.height : Math.floor(o.height / 2);
+      const panelWidth = horizontal ? Math.floor(o.width / picture.panels.length) : o.width;
+      const panelHeight = horizontal ? o.height : Math.floor(o.height / picture.panels.length);
       const page = await browser.newPage({ viewport: { width: panelWidth, height: panelHeight }, deviceScaleFactor: 1 });
       const errors = [];
       page.on('pageerror', (e) => errors.push(e.message));
@@ -462,7 +465,9 @@ async function main() {
         // The same region and move under each panel's method (a new method keeps the move).
         for (const method of [...new Set(picture.panels.map((p) => p.method ?? 'linear'))]) {
           if (method !== 'linear') {
-            await post('region', { support, handles: [handle], k: 2, method });
+            // 'blended-motions' is method nonlinear with that energy, as the page's switch sends it.
+            const request = method === 'blended-motions' ? { method: 'nonlinear', energy: method } : { method };
+            await post('region', { support, handles: [handle], k: 2, ...request });
             await settle();
           }
           for (const [i, panel] of picture.panels.entries())
@@ -506,7 +511,7 @@ function handleMatrix(edit, positions, handle) {
   return rows;
 }
 
-/// The two panels side by side (or stacked) with their labels and the caption, on a canvas in the
+/// The panels side by side (or stacked) with their labels and the caption, on a canvas in the
 /// browser; its pixels come back and are encoded here.
 async function compose(browser, picture, shots, width, height, horizontal) {
   const page = await browser.newPage({ viewport: { width, height }, deviceScaleFactor: 1 });
@@ -530,7 +535,8 @@ async function compose(browser, picture, shots, width, height, horizontal) {
         const image = new Image();
         image.src = images[i];
         await image.decode();
-        const x = horizontal ? i * Math.floor(width / 2) : 0, y = horizontal ? 0 : i * Math.floor(height / 2);
+        const x = horizontal ? i * Math.floor(width / images.length) : 0;
+        const y = horizontal ? 0 : i * Math.floor(height / images.length);
         g.drawImage(image, x, y);
         text(labels[i], x + font * 0.8, y + font * 1.6, font, '#dde2ea');
         if (i > 0) {

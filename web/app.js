@@ -92,7 +92,8 @@ async function fetchRegion(s, labelsKnown) {
       region.handles.forEach((h, j) => { for (const v of h) state.labels[v] = j; });
       state.k = region.k;
       panels.setK(region.k);
-      state.method = region.method ?? 'linear';
+      state.method = region.energy === 'blended-motions' && region.method === 'nonlinear'
+        ? 'blended-motions' : region.method ?? 'linear';
       panels.setMethod(state.method);
     }
     state.handleCount = Math.max(1, region?.handles.length ?? 0);
@@ -240,7 +241,7 @@ async function sendRegion({ keepGizmo = false, inStroke = false } = {}) {
   }
   if (busy() && state.status?.progress?.job !== 'region') await settle(); // a load: wait for it
   const steps = { started, lists: performance.now() };
-  const posted = post('region', { support, handles, k: state.k, method: state.method });
+  const posted = post('region', { support, handles, k: state.k, ...methodRequest(state.method) });
   // While the request travels and the server solves: the normal plan of the region sent (its
   // movable vertices are the support, handles included, sorted).
   state.sentMovable = Uint32Array.from(support);
@@ -459,6 +460,12 @@ function clear() {
 function setK(k) {
   state.k = k;
   if (state.movable && state.labels && !painting) task(() => sendRegion({ keepGizmo: true }));
+}
+/// The page's method choice as the API's: 'linear', 'nonlinear' (the server's default energy) or
+/// 'blended-motions' (method nonlinear with that energy: docs/editing.md, "Large rotations").
+function methodRequest(choice) {
+  if (choice === 'blended-motions') return { method: 'nonlinear', energy: 'blended-motions' };
+  return { method: choice };
 }
 function setMethod(method) {
   state.method = method;

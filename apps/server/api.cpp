@@ -7,6 +7,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <sstream>
 
 #include <fmt/format.h>
@@ -94,10 +95,10 @@ void only_keys(const json& j, std::initializer_list<const char*> keys) {
 
 HttpResponse region(Session& session, const HttpRequest& request, const ApiLimits& limits) {
   const json j = parse_json(request, limits);
-  only_keys(j, {"support", "handles", "k", "method"});
+  only_keys(j, {"support", "handles", "k", "method", "energy"});
   if (!j.contains("support") || !j.contains("handles"))
     throw BadRequest("expected {\"support\": [ids], \"handles\": [[ids], ...], \"k\": 1|2|3, "
-                     "\"method\": \"linear\"|\"nonlinear\"}");
+                     "\"method\": \"linear\"|\"nonlinear\", \"energy\": name}");
   std::vector<int> support = ids(j.at("support"), "support");
   const json& hs = j.at("handles");
   if (!hs.is_array()) throw BadRequest("handles: expected an array of arrays of vertex ids");
@@ -115,9 +116,16 @@ HttpResponse region(Session& session, const HttpRequest& request, const ApiLimit
       throw BadRequest("method: expected \"linear\" or \"nonlinear\"");
     method = parse_edit_method(j.at("method").get<std::string>());
   }
+  std::optional<NonlinearEnergy> energy;
+  if (j.contains("energy")) {
+    if (!j.at("energy").is_string())
+      throw BadRequest("energy: expected \"rotated-laplacian\", \"propagated\", "
+                       "\"blended-motions\" or \"arap\"");
+    energy = parse_nonlinear_energy(j.at("energy").get<std::string>());
+  }
   if (support.empty()) throw BadRequest("the support is empty: paint at least one vertex");
   if (handles.empty()) throw BadRequest("no handle: paint a handle inside the support");
-  session.start_region(std::move(support), std::move(handles), k, method);
+  session.start_region(std::move(support), std::move(handles), k, method, energy);
   return json_response(202, session.status());
 }
 

@@ -24,6 +24,7 @@ struct RegionKey {
   std::vector<std::vector<int>> handles;
   int k = 2;
   EditMethod method = EditMethod::Linear;
+  NonlinearEnergy energy = NonlinearEnergy::RotatedLaplacian; // method nonlinear's
   bool operator==(const RegionKey&) const = default;
 };
 
@@ -254,14 +255,17 @@ struct Session::Impl {
     Editor& editor = next->editor;
     const KHarmonicOptions previous_system = editor.options().system;
     const EditMethod previous_method = editor.options().method;
+    const NonlinearEnergy previous_energy = editor.options().nonlinear.energy;
     const auto restore = [&] {
       editor.set_system(previous_system);
       editor.set_method(previous_method);
+      editor.set_nonlinear_energy(previous_energy);
     };
     std::optional<Editor::Prepared> prepared;
     try {
       editor.set_system({key.k, previous_system.areas});
       editor.set_method(key.method);
+      editor.set_nonlinear_energy(key.energy);
       if (work.new_region) prepared = editor.prepare_region(key.support, key.handles, token);
     } catch (...) {
       restore();
@@ -367,7 +371,7 @@ void Session::start_load(std::string bytes, std::string name) {
 }
 
 void Session::start_region(std::vector<int> support, std::vector<std::vector<int>> handles, int k,
-                           EditMethod method) {
+                           EditMethod method, std::optional<NonlinearEnergy> energy) {
   std::lock_guard lock(impl_->mutex);
   Impl& m = *impl_;
   if (!(m.busy && m.job == "region")) m.require_ready(); // a region job: stopped and followed
@@ -394,13 +398,15 @@ void Session::start_region(std::vector<int> support, std::vector<std::vector<int
         throw InvalidArgument(fmt::format("handle vertex {} is out of range (the mesh has {} "
                                           "vertices)",
                                           v, n));
-  RegionKey key{std::move(support), std::move(handles), k, method};
+  RegionKey key{std::move(support), std::move(handles), k, method,
+                energy.value_or(m.options.editor.nonlinear.energy)};
   // Only k or the method changes: the same handles keep their transforms, solved again (no
   // bake), so that a user compares them on the same drag. A new method alone needs no new
   // set_region.
   const bool same_paint =
       m.region && m.region->support == key.support && m.region->handles == key.handles;
-  const bool resolve = same_paint && (m.region->k != key.k || m.region->method != key.method);
+  const bool resolve = same_paint && (m.region->k != key.k || m.region->method != key.method ||
+                                      m.region->energy != key.energy);
   const bool new_region = !resolve || m.region->k != key.k;
   const bool bake = !resolve && !is_identity(m.transforms);
   m.run("region", [this, key = std::move(key), bake, resolve, new_region, current = m.box,
@@ -492,6 +498,7 @@ nlohmann::json Session::status() const {
                    {"handles", m.region->handles.size()},
                    {"k", m.region->k},
                    {"method", to_string(m.region->method)},
+                   {"energy", to_string(m.region->energy)},
                    {"free_base_vertices", r.free_base_vertices},
                    {"set_region_ms",
                     r.milliseconds.count("set_region") ? r.milliseconds.at("set_region") : 0.0},
@@ -520,7 +527,8 @@ nlohmann::json Session::region() const {
   return {{"support", m.region->support},
           {"handles", m.region->handles},
           {"k", m.region->k},
-          {"method", to_string(m.region->method)}};
+          {"method", to_string(m.region->method)},
+          {"energy", to_string(m.region->energy)}};
 }
 
 namespace {

@@ -77,12 +77,14 @@ public:
   /// before the memory for it is allocated. Throws Busy while other work runs.
   void start_load(std::string bytes, std::string name);
   /// Starts a new region on the worker (baking the current result first when a handle moved,
-  /// except when only k or the method changes: then the handles keep their transforms and the
-  /// region is solved again under them). Validates first (InvalidArgument): k, ids in range, at
-  /// most max_handles handles, no list longer than the mesh has vertices. Throws Busy while
-  /// other work runs.
+  /// except when only k, the method or its energy changes: then the handles keep their
+  /// transforms and the region is solved again under them). `energy`: method nonlinear's, by
+  /// default options.editor's. Validates first (InvalidArgument): k, ids in range, at most
+  /// max_handles handles, no list longer than the mesh has vertices. Throws Busy while other
+  /// work runs.
   void start_region(std::vector<int> support, std::vector<std::vector<int>> handles, int k,
-                    EditMethod method = EditMethod::Linear);
+                    EditMethod method = EditMethod::Linear,
+                    std::optional<NonlinearEnergy> energy = std::nullopt);
   /// Blocks until the worker is idle (tests and the CLI).
   void wait();
   /// Blocks until the worker is idle or `timeout` has passed (a client's long poll of the
@@ -113,7 +115,7 @@ public:
   /// The loaded file's name ("" before the first load).
   std::string name() const;
   /// The current region as {"support": [ids], "handles": [[ids], ...], "k": k, "method":
-  /// "linear" | "nonlinear"}, or null.
+  /// "linear" | "nonlinear", "energy": method nonlinear's energy}, or null.
   nlohmann::json region() const;
   /// Current positions of every vertex (Float32 x, y, z) and the faces (Uint32 triples).
   std::vector<float> positions() const;

@@ -186,14 +186,15 @@ class Editor:
         """How the base follows the handles: "linear" or "nonlinear"."""
         return self._editor.method()
 
-    def set_method(self, method: str) -> None:
-        """Switches between "linear" and "nonlinear", for the current region and the next ones.
+    def set_method(self, method: str, energy: str | None = None) -> None:
+        """Switches between "linear" and "nonlinear", for the current region and the next ones;
+        ``energy`` (optional) also sets the nonlinear method's (``nonlinear_options``' names).
 
         Cheap: the next :meth:`positions` builds what "nonlinear" needs for the current region
-        (one factorization). The transforms stay. Raises ValueError (naming ``method``) for
-        another name.
+        (one factorization, none for "blended-motions"). The transforms stay. Raises ValueError
+        (naming ``method`` or ``energy``) for another name.
         """
-        self._editor.set_method(method)
+        self._editor.set_method(method, energy)
 
     @property
     def converged(self) -> bool:

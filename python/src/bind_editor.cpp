@@ -8,12 +8,14 @@
 #include <limits>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
+#include <pybind11/stl.h>
 
 #include "bindings.h"
 #include "convert.h"
@@ -193,14 +195,23 @@ public:
     locked([&] { editor_->set_transform(handle, t); });
   }
 
-  void set_method(const std::string& name) {
+  void set_method(const std::string& name, const std::optional<std::string>& energy_name) {
     EditMethod method = EditMethod::Linear;
+    std::optional<NonlinearEnergy> energy;
     try {
       method = parse_edit_method(name);
     } catch (const InvalidArgument& e) {
       throw InvalidArgument(fmt::format("method: {}", e.what()));
     }
-    locked([&] { editor_->set_method(method); });
+    try {
+      if (energy_name) energy = parse_nonlinear_energy(*energy_name);
+    } catch (const InvalidArgument& e) {
+      throw InvalidArgument(fmt::format("energy: {}", e.what()));
+    }
+    locked([&] {
+      if (energy) editor_->set_nonlinear_energy(*energy);
+      editor_->set_method(method);
+    });
   }
 
   std::string method() {
@@ -314,7 +325,7 @@ void bind_editor(py::module_& m) {
       .def("set_region", &PyEditor::set_region, py::arg("support"), py::arg("handles"))
       .def("set_transform", &PyEditor::set_transform, py::arg("handle"), py::arg("T"))
       .def("positions", &PyEditor::positions, py::arg("out"), py::arg("budget_ms"))
-      .def("set_method", &PyEditor::set_method, py::arg("method"))
+      .def("set_method", &PyEditor::set_method, py::arg("method"), py::arg("energy") = std::nullopt)
       .def("method", &PyEditor::method)
       .def("converged", &PyEditor::converged)
       .def("base", &PyEditor::base)

@@ -130,6 +130,13 @@ def test_blended_motions_keep_every_ring_in_closed_form(twisted):
     ring = P[rings]  # (rings, segments, 3)
     radii = np.linalg.norm(ring[:, :, :2] - ring[:, :, :2].mean(axis=1, keepdims=True), axis=2)
     assert np.abs(radii.mean(axis=1) - 1.0).max() < 0.02
+    # set_method switches the energy too, with the same region and transforms.
+    editor.set_method("nonlinear", energy="rotated-laplacian")
+    assert not np.array_equal(editor.positions(), P)
+    editor.set_method("nonlinear", energy="blended-motions")
+    assert np.array_equal(editor.positions(), P)
+    with pytest.raises(ValueError, match=r"energy: unknown nonlinear energy 'screw'"):
+        editor.set_method("nonlinear", energy="screw")
 
 
 def test_the_identity_gives_the_input(bunny):

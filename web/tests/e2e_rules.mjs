@@ -120,8 +120,8 @@ const pageVsServer = (page) => page.evaluate(async () => {
 
 /// The method switch after a move: nonlinear keeps the transforms and bends the support
 /// otherwise, converged; a drag under it is answered frame by frame and, once the pointer rests,
-/// relaxed until the server says converged, the page holding the server's positions; linear again
-/// gives back the linear shape.
+/// relaxed until the server says converged, the page holding the server's positions; blended
+/// motions keep the move too; linear again gives back the linear shape.
 async function methodAfterMove(page, c, edit) {
   const s0 = await c.json('status');
   const linear = await c.floats('mesh/positions');
@@ -155,6 +155,15 @@ async function methodAfterMove(page, c, edit) {
   check(frames > 0 && s2.nonlinear?.converged === true && off < 1e-6,
         `a nonlinear drag: ${frames} frames answered, then relaxed until converged (${JSON.stringify(s2.nonlinear)}), ` +
         `the page holding the server's positions (off by ${off})`);
+  // Blended motions: method nonlinear with that energy, the same transforms, no iteration.
+  await page.selectOption('#method', 'blended-motions');
+  await ready(page);
+  const sb = await c.json('status');
+  check(sb.region?.method === 'nonlinear' && sb.region?.energy === 'blended-motions' &&
+        JSON.stringify(sb.transforms) === JSON.stringify(s2.transforms) &&
+        sb.nonlinear?.converged === true && sb.nonlinear?.iterations === 0 &&
+        await pageVsServer(page) === 0,
+        `blended motions keep the transforms, converge at once, the page shows them (${JSON.stringify(sb.region)})`);
   await page.selectOption('#method', 'linear');
   await ready(page);
   const s3 = await c.json('status');

@@ -238,6 +238,9 @@ public:
   /// (a factorization, as in set_region; a failure leaves the linear result with a message in
   /// the report).
   void set_method(EditMethod method);
+  /// Method nonlinear's energy (multires/nonlinear.h), for the current region and the next ones;
+  /// cheap as set_method(): the next positions() call builds the region's nonlinear state again.
+  void set_nonlinear_energy(NonlinearEnergy energy);
   /// The centroid of handle j's vertices on O (the default center of rotations and scalings).
   Eigen::Vector3d handle_center(int handle) const;
 

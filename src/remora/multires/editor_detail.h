@@ -1,0 +1,117 @@
+// The editor's state (multires/editor.h), shared by its two files: editor.cpp (construction, the
+// frame, the report) and editor_region.cpp (the steps of set_region: paint, map to the base,
+// basis functions, details, memory). Internal: not installed.
+#pragma once
+
+#include <cstdint>
+#include <deque>
+#include <memory>
+#include <optional>
+#include <stop_token>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "remora/multires/editor.h"
+#include "remora/multires/frame.h"
+#include "remora/multires/limits.h"
+#include "remora/multires/multigrid.h"
+#include "remora/multires/nonlinear_region.h"
+
+namespace remora {
+
+/// A region of the editor: its labels, basis functions, details and the frame's state; with the
+/// report it was made with (set_region's figures) and the editor that made it.
+struct Editor::Prepared::State {
+  const void* owner = nullptr;
+  EditReport report;
+  // What it was prepared from (set_region's arguments and the system), to find it again.
+  std::vector<int> support;
+  std::vector<std::vector<int>> handle_ids;
+  KHarmonicOptions system;
+  std::vector<int> input_label; // per O vertex: kFixed, kFree or handle j
+  std::vector<int> base_label;  // per B vertex
+  int handles = 0;
+  std::vector<int> free_vertices; // B vertices, in the row order of `basis`
+  BasisRows basis;                // n_free × (3 + 4h)
+  std::vector<std::vector<int>> handle_base;
+  std::vector<Eigen::Vector3d> handle_centers;
+  Eigen::MatrixXd rest;         // B0
+  Eigen::MatrixXd rest_normals; // of B0
+  std::vector<int> encoded;     // O vertices with a detail, in increasing order
+  FrameDetails details;         // their details, decoded into the rows `encoded`
+  NormalPlan affected;          // B vertices whose normal can change, and their faces
+  std::vector<Transform> transforms;
+  FrameRows frame; // B under the transforms: positions and normals
+  Eigen::MatrixXd current_positions;
+  std::vector<double> face_normals; // update_normals()'s scratch
+  bool dirty = true;
+  std::unique_ptr<NonlinearRegion> nonlinear; // method nonlinear (multires/nonlinear_region.h)
+  NonlinearEnergy nonlinear_energy{};         // what `nonlinear` was built for
+  std::shared_ptr<const RemeshResult> coarse; // its preview level (kept by the editor)
+  std::uint64_t bytes = 0; // its estimated memory (region_bytes() of multires/limits.h)
+};
+
+using RegionState = Editor::Prepared::State;
+
+struct Editor::Impl {
+  EditorOptions options;
+  Mesh input;
+  Eigen::MatrixXd input_positions;
+  TriangleTopology input_topology;
+  std::shared_ptr<const LowPassFilter> filter; // immutable: editors made by a bake share it
+  Eigen::MatrixXd smooth;                      // S = filter(O)
+  Mesh base;
+  TriangleTopology topology;
+  Eigen::MatrixXd base_rest;    // B
+  Eigen::MatrixXd base_normals; // of B
+  std::vector<SurfacePoint> base_on_input, input_on_base;
+  std::vector<std::pair<int, int>> negative_edges; // of B
+  std::optional<KHarmonicAssembler> assembler;     // B's systems
+  BaseStatistics statistics;                       // of B: what a bake updates the report from
+  std::unique_ptr<MultigridSolver> multigrid;
+  std::shared_ptr<const RemeshResult> coarse; // method nonlinear's preview level, for every region
+  EditReport report;
+  std::unique_ptr<RegionState> region;
+  // The regions installed before the current one, the latest first: set_region() of one of them
+  // again (an undo) installs it as it was, without the work.
+  std::deque<std::unique_ptr<RegionState>> recent;
+  static constexpr std::size_t kRecentRegions = 2;
+
+  void progress(std::string_view phase, int step, int steps) const {
+    if (options.progress) options.progress(phase, step, steps);
+  }
+  std::string solver_name(bool symmetric) const {
+    if (!options.solver.name.empty()) return options.solver.name;
+    return symmetric ? default_solver_name() : "lu";
+  }
+  RegionState& state() {
+    if (!region) throw InvalidArgument("no region yet: call set_region() first");
+    return *region;
+  }
+  void update(double budget_ms);
+  void build_nonlinear(RegionState& r, EditReport& into);
+  void deform_base(RegionState& r, bool moved, double budget_ms);
+
+  // The steps of set_region(), in order, on a new state (the current region stays until all
+  // succeed).
+  std::unique_ptr<RegionState> paint(const std::vector<int>& support,
+                                     const std::vector<std::vector<int>>& handles) const;
+  void map_to_base(RegionState& r) const;
+  void report_region(const RegionState& r, EditReport& out) const;
+  Eigen::MatrixXd constrained_values(const RegionState& r, const std::vector<int>& vertices,
+                                     bool by_vertex) const;
+  void solve_basis(RegionState& r, EditReport& out, const std::stop_token& stop);
+  void encode_details(RegionState& r, EditReport& out, const std::stop_token& stop) const;
+  void find_affected(RegionState& r) const;
+
+  // The memory limit (options.memory_bytes; 0 = none). The preprocessing's estimate, by the input
+  // triangles.
+  std::uint64_t preprocessing_bytes() const { return kEditorBytesPerTriangle * input.n_faces(); }
+  void bytes_for(RegionState& r) const;
+  void make_room(std::uint64_t beside);
+};
+
+} // namespace remora
