@@ -53,7 +53,8 @@ demo: build
 serve: build
 	$(BUILD)/bin/remora serve $(DEMO_MESH) --port $(PORT)
 
-# The pictures in docs/images/ (bunny_ear, acrossriver_lift, base_area, needles_base), rendered
+# The pictures in docs/images/ (bunny_ear, acrossriver_lift, base_area, needles_base,
+# cylinder_twist, bunny_ear_twist), rendered
 # from real results: `remora serve` edits, the page draws in headless chromium
 # (scripts/render_pictures.mjs; chromium is installed when missing). The shared meshes come from
 # ../shared/data (or REMORA_DATA); a missing one skips its picture. Not part of `make test`, whose

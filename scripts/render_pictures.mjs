@@ -138,9 +138,9 @@ const PICTURES = [
             rotate: { axis: [0, 1, 0], degrees: 90 } },
     caption: 'the ear\'s tip turned 90° about y',
     panels: [
-      { label: 'linear', stage: 'after', method: 'linear', camera: [0.1, 0.2, 0.34, -0.02, 0.115, 0.0] },
-      { label: 'nonlinear', stage: 'after', method: 'nonlinear', camera: [0.1, 0.2, 0.34, -0.02, 0.115, 0.0] },
-      { label: 'blended motions', stage: 'after', method: 'blended-motions', camera: [0.1, 0.2, 0.34, -0.02, 0.115, 0.0] },
+      { label: 'linear', stage: 'after', method: 'linear', camera: [0.02, 0.19, 0.16, -0.035, 0.15, 0.0] },
+      { label: 'nonlinear', stage: 'after', method: 'nonlinear', camera: [0.02, 0.19, 0.16, -0.035, 0.15, 0.0] },
+      { label: 'blended motions', stage: 'after', method: 'blended-motions', camera: [0.02, 0.19, 0.16, -0.035, 0.15, 0.0] },
     ],
   },
   {
@@ -406,8 +406,12 @@ async function main() {
     for (const picture of todo) {
       const started = Date.now();
       const horizontal = picture.layout === 'row';
-      const panelWidth = horizontal ? Math.floor(o.width / picture.panels.length) : o.width;
-      const panelHeight = horizontal ? o.height : Math.floor(o.height / picture.panels.length);
+      // --width and --height are a two-panel picture's; a third panel widens (or heightens) it.
+      const n = picture.panels.length;
+      const width = horizontal ? Math.round((o.width * n) / 2) : o.width;
+      const height = horizontal ? o.height : Math.round((o.height * n) / 2);
+      const panelWidth = horizontal ? Math.floor(width / n) : width;
+      const panelHeight = horizontal ? height : Math.floor(height / n);
       const page = await browser.newPage({ viewport: { width: panelWidth, height: panelHeight }, deviceScaleFactor: 1 });
       const errors = [];
       page.on('pageerror', (e) => errors.push(e.message));
@@ -477,10 +481,10 @@ async function main() {
       }
       await page.close();
 
-      const png = await compose(browser, picture, shots, o.width, o.height, horizontal);
+      const png = await compose(browser, picture, shots, width, height, horizontal);
       const path = join(o.out, `${picture.name}.png`);
       writeAtomically(path, png);
-      console.log(`wrote ${path} (${o.width}x${o.height}, ${(png.length / 1024).toFixed(0)} KB, ` +
+      console.log(`wrote ${path} (${width}x${height}, ${(png.length / 1024).toFixed(0)} KB, ` +
                   `${((Date.now() - started) / 1000).toFixed(1)} s)`);
     }
   } finally {

