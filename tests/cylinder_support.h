@@ -95,6 +95,38 @@ inline Transform bend(const Cylinder& c, double radians) {
   return t;
 }
 
+/// The scaled handles of the nonlinear tests: the top scaled by 1.5 about its centre, or by 1.5
+/// along x and then twisted by 90°.
+inline Transform scaled_top(const Cylinder& c, bool twisted) {
+  return twisted ? compose(twist(c, kPi / 2), scaling({1.5, 1.0, 1.0}, {0, 0, c.height}))
+                 : scaling({1.5, 1.5, 1.5}, {0, 0, c.height});
+}
+
+/// A scaled top's flare, ring by ring (each ring's mean distance from the axis): how far a
+/// method's radii are from the linear method's, the smallest of each, and the top ring's.
+struct Flare {
+  double worst_difference = 0.0, smallest_linear = 0.0, smallest = 0.0, top_linear = 0.0, top = 0.0;
+};
+
+inline Flare flare(const Cylinder& c, const Eigen::MatrixXd& linear, const Eigen::MatrixXd& other) {
+  const auto radii = [&c](const Eigen::MatrixXd& p) {
+    std::vector<double> r(static_cast<std::size_t>(c.rings + 1), 0.0);
+    for (int k = 0; k <= c.rings; ++k)
+      for (int s = 0; s < c.segments; ++s)
+        r[static_cast<std::size_t>(k)] += p.row(c.id(k, s)).head<2>().norm() / c.segments;
+    return r;
+  };
+  const std::vector<double> a = radii(linear), b = radii(other);
+  Flare f;
+  for (std::size_t k = 0; k < a.size(); ++k)
+    f.worst_difference = std::max(f.worst_difference, std::abs(b[k] - a[k]));
+  f.smallest_linear = *std::min_element(a.begin(), a.end());
+  f.smallest = *std::min_element(b.begin(), b.end());
+  f.top_linear = a.back();
+  f.top = b.back();
+  return f;
+}
+
 inline double max_row_distance(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
   return (a - b).rowwise().norm().maxCoeff();
 }

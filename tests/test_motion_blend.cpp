@@ -41,6 +41,8 @@ TEST(ScrewMotion, ExpInvertsLogAndHalfATwistTwiceIsTheWhole) {
     screw_exp(s, r2, t2);
     EXPECT_LT((r2 - r).norm(), 1e-12) << angle;
     EXPECT_LT((t2 - t).norm(), 1e-12) << angle;
+    const Eigen::Vector3d y(0.3, 0.7, -1.1);
+    EXPECT_LT((screw_apply(s, y) - (r * y + t)).norm(), 1e-12) << angle;
     s.omega *= 0.5;
     s.v *= 0.5;
     screw_exp(s, r2, t2); // the half motion, applied twice
@@ -143,32 +145,20 @@ TEST(BlendedMotions, AScaledHandleFlaresTheTubeLikeTheLinearMethod) {
   Editor linear(c.mesh), blended(c.mesh, blended_options());
   linear.set_region(c.support, {c.handle});
   blended.set_region(c.support, {c.handle});
-  const auto radii = [&c](const Eigen::MatrixXd& p) {
-    std::vector<double> r(static_cast<std::size_t>(c.rings + 1), 0.0);
-    for (int k = 0; k <= c.rings; ++k)
-      for (int s = 0; s < c.segments; ++s)
-        r[static_cast<std::size_t>(k)] += p.row(c.id(k, s)).head<2>().norm() / c.segments;
-    return r;
-  };
   for (const bool twisted : {false, true}) {
-    const Transform t = twisted ? compose(twist(c, kPi / 2), scaling({1.5, 1.0, 1.0}, {0, 0, 4}))
-                                : scaling({1.5, 1.5, 1.5}, {0, 0, c.height});
+    const Transform t = scaled_top(c, twisted);
     linear.set_transform(0, t);
     blended.set_transform(0, t);
-    const std::vector<double> a = radii(linear.positions()), b = radii(blended.positions());
-    double worst = 0.0;
-    for (std::size_t k = 0; k < a.size(); ++k) worst = std::max(worst, std::abs(b[k] - a[k]));
-    const double smallest_a = *std::min_element(a.begin(), a.end());
-    const double smallest_b = *std::min_element(b.begin(), b.end());
+    const Flare f = flare(c, linear.positions(), blended.positions());
     std::cout << (twisted ? "scaled and twisted" : "scaled") << " handle: radii differ from the "
-              << "linear method's by at most " << worst << "; smallest mean radius linear "
-              << smallest_a << ", blended motions " << smallest_b << "\n";
-    EXPECT_NEAR(b.back(), a.back(), 0.01); // the top circle: where the handle puts it
+              << "linear method's by at most " << f.worst_difference << "; smallest mean radius "
+              << "linear " << f.smallest_linear << ", blended motions " << f.smallest << "\n";
+    EXPECT_NEAR(f.top, f.top_linear, 0.01); // the top circle: where the handle puts it
     if (twisted) {
-      EXPECT_LT(smallest_a, 0.9);
-      EXPECT_GT(smallest_b, 0.98);
+      EXPECT_LT(f.smallest_linear, 0.9);
+      EXPECT_GT(f.smallest, 0.98);
     } else { // the k = 2 weights dip below 0 near the fixed circle: a slight waist there
-      EXPECT_LT(worst, 0.04);
+      EXPECT_LT(f.worst_difference, 0.04);
     }
   }
 }

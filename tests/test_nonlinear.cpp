@@ -214,32 +214,20 @@ TEST(Nonlinear, AScaledHandleFlaresTheSupportLikeTheLinearMethod) {
   Editor linear(c.mesh), nonlinear(c.mesh, nonlinear_options());
   linear.set_region(c.support, {c.handle});
   nonlinear.set_region(c.support, {c.handle});
-  const auto radii = [&c](const Eigen::MatrixXd& p) {
-    std::vector<double> r(static_cast<std::size_t>(c.rings + 1), 0.0);
-    for (int k = 0; k <= c.rings; ++k)
-      for (int s = 0; s < c.segments; ++s)
-        r[static_cast<std::size_t>(k)] += p.row(c.id(k, s)).head<2>().norm() / c.segments;
-    return r;
-  };
   for (const bool twisted : {false, true}) {
-    const Transform t = twisted ? compose(twist(c, kPi / 2), scaling({1.5, 1.0, 1.0}, {0, 0, 4}))
-                                : scaling({1.5, 1.5, 1.5}, {0, 0, c.height});
+    const Transform t = scaled_top(c, twisted);
     linear.set_transform(0, t);
     nonlinear.set_transform(0, t);
-    const std::vector<double> a = radii(linear.positions()), b = radii(nonlinear.positions());
-    double worst = 0.0;
-    for (std::size_t k = 0; k < a.size(); ++k) worst = std::max(worst, std::abs(b[k] - a[k]));
-    const double smallest_a = *std::min_element(a.begin(), a.end());
-    const double smallest_b = *std::min_element(b.begin(), b.end());
+    const Flare f = flare(c, linear.positions(), nonlinear.positions());
     std::cout << (twisted ? "scaled and twisted" : "scaled") << " handle: radii differ from the "
-              << "linear method's by at most " << worst << "; smallest mean radius linear "
-              << smallest_a << ", nonlinear " << smallest_b << "\n";
-    EXPECT_NEAR(b.back(), a.back(), 0.01); // the top circle: where the handle puts it
+              << "linear method's by at most " << f.worst_difference << "; smallest mean radius "
+              << "linear " << f.smallest_linear << ", nonlinear " << f.smallest << "\n";
+    EXPECT_NEAR(f.top, f.top_linear, 0.01); // the top circle: where the handle puts it
     if (twisted) {
-      EXPECT_LT(smallest_a, 0.9);
-      EXPECT_GT(smallest_b, 0.94);
+      EXPECT_LT(f.smallest_linear, 0.9);
+      EXPECT_GT(f.smallest, 0.94);
     } else {
-      EXPECT_LT(worst, 0.03);
+      EXPECT_LT(f.worst_difference, 0.03);
     }
     EXPECT_TRUE(nonlinear.converged());
   }

@@ -62,6 +62,17 @@ void screw_exp(const ScrewTwist& twist, Matrix3& r, Vector3& t) {
   t = twist.v + a * (w * twist.v) + b * (w2 * twist.v);
 }
 
+Vector3 screw_apply(const ScrewTwist& twist, const Vector3& y) {
+  const double theta = twist.omega.norm();
+  double a = 0.0, b = 0.0;
+  left_jacobian_coefficients(theta, a, b);
+  const double s = theta < 1e-4 ? 1.0 - theta * theta / 6.0 : std::sin(theta) / theta;
+  const Vector3& w = twist.omega;
+  // R y + t with R = I + s W + a W², t = (I + a W + b W²) v, W u = ω × u.
+  const Vector3 wy = w.cross(y), wv = w.cross(twist.v);
+  return y + s * wy + a * w.cross(wy) + twist.v + a * wv + b * w.cross(wv);
+}
+
 HandleMotions handle_motions(const std::vector<Eigen::Matrix<double, 3, 4>>& maps,
                              const std::vector<Vector3>& pivots) {
   if (maps.size() != pivots.size())
@@ -102,10 +113,7 @@ void blend_motions(const RowPoints& rest, const Eigen::MatrixXd& weights,
       if (motions.stretched)
         y += w * ((motions.stretch[j] - Matrix3::Identity()) * (p - motions.pivot[j]));
     }
-    Matrix3 r;
-    Vector3 t;
-    screw_exp(sum, r, t);
-    x.row(v) = (r * y + t).transpose();
+    x.row(v) = screw_apply(sum, y).transpose();
   });
 }
 

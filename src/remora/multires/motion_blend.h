@@ -45,6 +45,9 @@ ScrewTwist screw_log(const Eigen::Matrix3d& r, const Eigen::Vector3d& t);
 /// exp of a twist: the rotation `r` and translation `t` of the motion y -> r y + t.
 void screw_exp(const ScrewTwist& twist, Eigen::Matrix3d& r, Eigen::Vector3d& t);
 
+/// exp(twist) applied to the point y: r y + t of screw_exp(), without forming r.
+Eigen::Vector3d screw_apply(const ScrewTwist& twist, const Eigen::Vector3d& y);
+
 /// The handles' maps prepared for blending: their twists, stretches and pivots.
 struct HandleMotions {
   std::vector<ScrewTwist> twist;

@@ -593,15 +593,12 @@ void NonlinearDeformer::set_transforms(const std::vector<AffineMap>& transforms,
       m.x.row(static_cast<Eigen::Index>(v)) =
           (t.leftCols<3>() * m.rest.row(static_cast<Eigen::Index>(v)).transpose() + t.col(3))
               .transpose();
-    } else if (label == Region::kFixed) {
-      m.x.row(static_cast<Eigen::Index>(v)) = m.rest.row(static_cast<Eigen::Index>(v));
-    }
+    } // the fixed rows keep x⁰: nothing writes them
   }
   if (m.blended) { // closed form: the result, no iteration
     blend_motions(m.rest, m.weights, m.free_vertices, handle_motions(transforms, m.pivots), m.x,
                   m.options.threads);
     m.current_energy = 0.0;
-    m.previous_guess = m.free_vector();
     m.stats.converged = true;
     return;
   }
