@@ -95,6 +95,9 @@ test-release: build
 # The sanitized build is compiled by clang at -O1 -g1 (line tables only): -O1 -g1 takes 40 % less
 # compile time than -O2 -g on the test files, and clang a third less than GCC under the
 # sanitizers; the same checks, stack traces with file and line, and a second compiler's warnings.
+# The sanitized trees are unity builds (CMake's batches of 8 files; the tests stay one file each):
+# the same code in 40 % less compile time. The release build compiles every file alone, so a
+# missing include still fails there.
 #
 # The tests that ASAN_RELEASE_ONLY matches run in the release build only: numerical figures on
 # large inputs (the shared meshes' remesh suites, but for two CAD parts, gears and featuretype,
@@ -107,7 +110,8 @@ test-asan: deps
 	cmake -S . -B $(ASAN_BUILD) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DREMORA_WERROR=ON \
 	  -DCMAKE_CXX_COMPILER=$(ASAN_CXX) \
 	  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG" -DREMORA_SANITIZE=ON \
-	  -DREMORA_BUILD_BENCH=OFF -DREMORA_BUILD_WEB=OFF -DREMORA_BUILD_FUZZ=ON $(CMAKE_FLAGS)
+	  -DREMORA_BUILD_BENCH=OFF -DREMORA_BUILD_WEB=OFF -DREMORA_BUILD_FUZZ=ON -DCMAKE_UNITY_BUILD=ON \
+	  $(CMAKE_FLAGS)
 	cmake --build $(ASAN_BUILD) -j$(JOBS)
 	cd $(ASAN_BUILD) && $(TEST_ENV) REMORA_SANITIZED=1 ASAN_OPTIONS=detect_leaks=1 \
 	  UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 FUZZ_NICE=0 ctest --output-on-failure -j$(JOBS) \
@@ -122,7 +126,7 @@ test-tsan: deps
 	cmake -S . -B $(TSAN_BUILD) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DREMORA_WERROR=ON \
 	  -DCMAKE_CXX_COMPILER=$(ASAN_CXX) \
 	  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG" -DREMORA_SANITIZE_THREAD=ON \
-	  -DREMORA_BUILD_BENCH=OFF -DREMORA_BUILD_WEB=OFF $(CMAKE_FLAGS)
+	  -DREMORA_BUILD_BENCH=OFF -DREMORA_BUILD_WEB=OFF -DCMAKE_UNITY_BUILD=ON $(CMAKE_FLAGS)
 	cmake --build $(TSAN_BUILD) -j$(JOBS) --target remora_tests
 	cd $(TSAN_BUILD) && $(TEST_ENV) REMORA_SANITIZED=1 TSAN_OPTIONS=$(TSAN_OPTIONS_ALL) \
 	  OMP_TOOL_LIBRARIES=$$($(ASAN_CXX) -print-resource-dir)/../../libarcher.so \

@@ -10,6 +10,7 @@
 
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "remora/common/error.h"
 #include "remora/geometry/laplacian.h"
@@ -272,6 +273,28 @@ TEST(Editor, MeanAreaAndExactAreaSolutionsAgreeOnTheEqualizedBase) {
   std::cout << "mean vs exact areas: " << difference / bounding_box_diagonal(mesh)
             << " of the bbox diagonal\n";
   EXPECT_LE(difference, 1e-3 * bounding_box_diagonal(mesh));
+}
+
+// Only the input's vertices move: a support whose own edges are much longer than the base's
+// bends in facets, and set_region says so. The same sphere remeshed at its own edge length is
+// not too coarse; remeshed at a sixth of it, its triangles are.
+TEST(Editor, ASupportOfLongTrianglesIsReported) {
+  const Mesh mesh = bumpy_sphere(3);
+  const auto support = sphere_ids(mesh, Vec3(0, 0, 1), 0.8);
+  const auto handle = sphere_ids(mesh, Vec3(0, 0, 1), 0.2);
+  Editor fine(mesh);
+  fine.set_region(support, {handle});
+  EXPECT_GT(fine.report().support_edge_ratio, 0.5);
+  EXPECT_LT(fine.report().support_edge_ratio, 2.0);
+  EXPECT_TRUE(fine.report().coarse_support.empty());
+  EditorOptions o;
+  o.remesh_options.target_length = mean_edge_length(mesh) / 6.0;
+  Editor coarse(mesh, o);
+  coarse.set_region(support, {handle});
+  const EditReport& r = coarse.report();
+  EXPECT_GT(r.support_edge_ratio, kCoarseSupportRatio);
+  EXPECT_NE(r.coarse_support.find("bends in facets"), std::string::npos) << r.coarse_support;
+  EXPECT_EQ(to_json(r)["region"]["coarse_support"], r.coarse_support);
 }
 
 TEST(Editor, ErrorsNameTheProblem) {

@@ -16,12 +16,12 @@
 #include "remora/multires/editor.h"
 #include "remora/multires/motion_blend.h"
 
-#include "cylinder_support.h"
+#include "nonlinear_support.h"
 
 namespace remora {
 namespace {
 
-using namespace cylinder_testing;
+using namespace nonlinear_testing;
 
 EditorOptions blended_options() {
   EditorOptions o;
@@ -52,40 +52,14 @@ TEST(ScrewMotion, ExpInvertsLogAndHalfATwistTwiceIsTheWhole) {
 }
 
 TEST(BlendedMotions, AreExactForTheIdentityAndOneRigidOrAffineMapOfEveryHandle) {
-  Mesh sphere = make_icosphere(3, 1.0);
-  for (const VertexHandle v : sphere.vertices()) {
-    const Vec3 p = sphere.point(v);
-    sphere.set_point(v, p * (1.0 + 0.03 * std::sin(9 * p[0]) * std::sin(9 * p[1])));
-  }
-  std::vector<int> all(sphere.n_vertices());
-  for (std::size_t i = 0; i < all.size(); ++i) all[i] = static_cast<int>(i);
-  Editor editor(sphere, blended_options());
-  editor.set_region(
-      all, {select_sphere(sphere, Vec3(0, 0, 1), 0.5), select_sphere(sphere, Vec3(0, 0, -1), 0.5)});
+  const CappedSphere s = capped_sphere();
+  Editor editor(s.mesh, blended_options());
+  editor.set_region(s.support, s.handles);
   const Eigen::MatrixXd rest = editor.base_positions();
-  const double diagonal = bounding_box_diagonal(sphere);
-  const Transform rigid =
-      compose(translation({0.4, -0.2, 1.5}), rotation({1, 2, 3}, 2.0, {0.1, 0.2, 0.3}));
-  const Transform affine = compose(rigid, scaling({1.5, 0.7, 1.1}, {0.1, 0.0, 0.2}));
-  for (const Transform& t : {rigid, affine}) {
-    editor.set_transform(0, t);
-    editor.set_transform(1, t);
-    const Eigen::MatrixXd moved =
-        ((t.leftCols<3>() * rest.transpose()).colwise() + t.col(3)).transpose();
-    EXPECT_LT(max_row_distance(editor.base_positions(), moved), 1e-9 * diagonal);
-    EXPECT_TRUE(editor.converged());
-    EXPECT_EQ(editor.report().nonlinear.total_iterations, 0);
-  }
-  // The details ride along a rigid motion exactly.
-  editor.set_transform(0, rigid);
-  editor.set_transform(1, rigid);
-  const Eigen::MatrixXd input = positions_matrix(sphere);
-  EXPECT_LT(max_row_distance(
-                editor.positions(),
-                ((rigid.leftCols<3>() * input.transpose()).colwise() + rigid.col(3)).transpose()),
-            1e-9 * diagonal);
+  for (const Transform& t : {some_rigid_map(), some_affine_map()})
+    expect_one_map_moves_everything(editor, s, t, 0, rest);
   editor.set_transform(0, rotation({0, 1, 0}, 1.0, {0, 0, 1}));
-  EXPECT_GT(max_row_distance(editor.base_positions(), rest), 0.1 * diagonal);
+  EXPECT_GT(max_row_distance(editor.base_positions(), rest), 0.1 * s.diagonal);
   editor.set_transform(0, identity_transform());
   editor.set_transform(1, identity_transform());
   EXPECT_EQ(editor.base_positions(), rest);

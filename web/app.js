@@ -301,7 +301,9 @@ function regionShown({ failed, s, steps, keepGizmo, seq }) {
   }
   setTool('orbit');
   placeGizmo(); // on the handle of this region
-  message('Region ready; the Orbit tool is on: drag the arrows to move the handle (S, H: paint again).', 'info');
+  // A support of long triangles (a CAD part's own) bends in facets: said, with what to do.
+  if (s.region?.coarse_support) message(`Region ready, but ${s.region.coarse_support}.`, 'hint');
+  else message('Region ready; the Orbit tool is on: drag the arrows to move the handle (S, H: paint again).', 'info');
 }
 
 // ---- handles and the manipulator ----------------------------------------------------------------

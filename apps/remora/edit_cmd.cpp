@@ -102,6 +102,7 @@ void print_edit_report(std::ostream& os, const EditReport& r, double load_ms, do
                     "constrained, {} negative cotan weights in the support\n",
                     grouped(r.support_vertices), handles, grouped(r.free_base_vertices),
                     grouped(r.constrained_base_vertices), grouped(r.negative_weights_in_support));
+  if (!r.coarse_support.empty()) os << "warning: " << r.coarse_support << "\n";
   os << fmt::format("solver: {}, {} right-hand sides", r.solver, r.solves);
   if (r.solver_stats.iterations > 0)
     os << fmt::format(", {} iterations, residual {:.2e}", r.solver_stats.iterations,

@@ -502,7 +502,8 @@ nlohmann::json Session::status() const {
                    {"free_base_vertices", r.free_base_vertices},
                    {"set_region_ms",
                     r.milliseconds.count("set_region") ? r.milliseconds.at("set_region") : 0.0},
-                   {"movable", m.box->editor.movable_vertices().size()}};
+                   {"movable", m.box->editor.movable_vertices().size()},
+                   {"coarse_support", r.coarse_support}};
     nlohmann::json transforms = nlohmann::json::array();
     for (const Transform& t : m.transforms) {
       std::vector<double> row_major;

@@ -16,9 +16,10 @@
 // medians. The last line printed is one JSON object with these keys.
 //
 //   node web/tests/bench.mjs --cli build/bin/remora --web-root build/web [--mesh data/bunny.ply]
-//        [--support-radius R] [--moves N] [--quick]
+//        [--support-radius R] [--moves N] [--method linear|nonlinear|blended-motions] [--quick]
 // R is in the mesh's units (default: a fifth of its bounding radius); the support is painted at
-// the surface under the view's centre. --quick: no drawn figures and no bake (their keys are
+// the surface under the view's centre. --method: the page's method switch, set before the support
+// is painted (default linear). --quick: no drawn figures and no bake (their keys are
 // null). Exit code 0: done, 1: failed, 77: chromium or playwright-core missing.
 import { args, chromiumOrSkip, client, drag, ready, startServer } from './harness.mjs';
 
@@ -39,6 +40,7 @@ try {
   page.on('pageerror', (e) => { console.log('page error:', e.message); failed = true; });
   await page.goto(url);
   await ready(page, 600000);
+  if (args.method) await page.selectOption('#method', args.method);
   const marks = () => page.evaluate(() => window.remora.marks());
   const paintableAt = await page.evaluate(() => performance.timeOrigin + window.remora.marks().paintable);
   const box = await page.locator('canvas').boundingBox();

@@ -17,7 +17,7 @@ namespace {
 
 // Doubled area over the longest squared edge (about the smallest angle in radians) at or below
 // which a face counts as zero-area: its cotangents would be rounding noise of size up to 1e16.
-constexpr double kDegenerate = 1e-12;
+constexpr double kZeroAreaFace = 1e-12;
 
 /// Half the cotangent of each corner of face f, with the edge opposite it: {weight, edge idx()}
 /// per corner; weight 0 for a zero-area face.
@@ -40,7 +40,7 @@ std::array<std::pair<double, int>, 3> half_cotangents(const Mesh& mesh, FaceHand
   std::array<std::pair<double, int>, 3> out;
   for (std::size_t k = 0; k < 3; ++k) {
     out[k] = {0.0, mesh.edge_handle(opposite[k]).idx()};
-    if (!(twice_area > kDegenerate * l[longest])) continue;
+    if (!(twice_area > kZeroAreaFace * l[longest])) continue;
     // The corner's edge vectors are -e[k+1] and e[k+2]; cot = their dot / |their cross|.
     out[k].first = 0.5 * (-(e[(k + 1) % 3] | e[(k + 2) % 3]) / twice_area);
   }

@@ -19,7 +19,9 @@ std::array<Vec3, 3> face_points(const Mesh& mesh, FaceHandle f) {
           mesh.point(mesh.to_vertex_handle(h2))};
 }
 
-std::array<VertexHandle, 3> face_vertices(const Mesh& mesh, FaceHandle f) {
+// to(h), to(next(h)), to(next(next(h))): the order of face_points() (surface_point.h's
+// face_vertices() starts one corner earlier; these figures keep their own order, bit for bit).
+std::array<VertexHandle, 3> halfedge_cycle_vertices(const Mesh& mesh, FaceHandle f) {
   const HalfedgeHandle h0 = mesh.halfedge_handle(f);
   const HalfedgeHandle h1 = mesh.next_halfedge_handle(h0);
   const HalfedgeHandle h2 = mesh.next_halfedge_handle(h1);
@@ -106,19 +108,19 @@ Eigen::VectorXd vertex_areas_barycentric(const Mesh& mesh) {
       per_face<double>(mesh, [&](FaceHandle f) { return face_area(mesh, f) / 3.0; });
   Eigen::VectorXd areas = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(mesh.n_vertices()));
   for (const FaceHandle f : mesh.faces())
-    for (const VertexHandle v : face_vertices(mesh, f))
+    for (const VertexHandle v : halfedge_cycle_vertices(mesh, f))
       areas[v.idx()] += thirds[static_cast<std::size_t>(f.idx())];
   return areas;
 }
 
 Eigen::VectorXd vertex_areas_mixed(const Mesh& mesh) {
   const auto parts = per_face<std::array<double, 3>>(mesh, [&](FaceHandle f) {
-    const std::array<VertexHandle, 3> v = face_vertices(mesh, f);
+    const std::array<VertexHandle, 3> v = halfedge_cycle_vertices(mesh, f);
     return triangle_mixed_areas(mesh.point(v[0]), mesh.point(v[1]), mesh.point(v[2]));
   });
   Eigen::VectorXd areas = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(mesh.n_vertices()));
   for (const FaceHandle f : mesh.faces()) {
-    const std::array<VertexHandle, 3> v = face_vertices(mesh, f);
+    const std::array<VertexHandle, 3> v = halfedge_cycle_vertices(mesh, f);
     for (int i = 0; i < 3; ++i)
       areas[v[i].idx()] += parts[static_cast<std::size_t>(f.idx())][static_cast<std::size_t>(i)];
   }

@@ -388,6 +388,8 @@ nlohmann::json to_json(const EditReport& r) {
                  {"constrained_base_vertices", r.constrained_base_vertices},
                  {"handle_base_vertices", r.handle_base_vertices},
                  {"negative_cotan_weights_in_support", r.negative_weights_in_support},
+                 {"support_edge_ratio", r.support_edge_ratio},
+                 {"coarse_support", r.coarse_support},
                  {"reused", r.region_reused}};
   j["solver"] = {{"name", r.solver},
                  {"solves", r.solves},

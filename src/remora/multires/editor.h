@@ -96,6 +96,9 @@ struct EditorOptions {
   std::function<void(std::string_view phase, int step, int steps)> progress;
 };
 
+/// EditReport::coarse_support is set above this support_edge_ratio.
+inline constexpr double kCoarseSupportRatio = 4.0;
+
 struct EditReport {
   std::size_t input_vertices = 0, input_faces = 0;
   std::size_t base_vertices = 0, base_faces = 0;
@@ -116,6 +119,12 @@ struct EditReport {
   /// Edges of the system's mesh with a free end whose cotan weight is negative (none on a good
   /// remesh; many on a scan's own connectivity).
   std::size_t negative_weights_in_support = 0;
+  /// The longest edge of O with both ends in the support over the base's edge length (its
+  /// target length, or with no remesh its mean edge length). Only O's vertices move, so a
+  /// support whose own triangles are much longer than the base's bends in facets.
+  double support_edge_ratio = 0.0;
+  /// Set when support_edge_ratio exceeds kCoarseSupportRatio: what the user sees and can do.
+  std::string coarse_support;
   /// The region was one of the last ones installed, set again (an undo): installed as it was,
   /// without the work; the other figures are those of its first set_region().
   bool region_reused = false;

@@ -115,6 +115,25 @@ void Editor::Impl::report_region(const RegionState& r, EditReport& out) const {
   out.constrained_base_vertices = constrained;
   out.handle_base_vertices.clear();
   for (const auto& h : r.handle_base) out.handle_base_vertices.push_back(h.size());
+  // The support's own edges against the base's: a support of long triangles bends in facets.
+  double longest = 0.0;
+  for (const auto& f : input_topology.faces)
+    for (int k = 0; k < 3; ++k) {
+      const int a = f[static_cast<std::size_t>(k)], b = f[static_cast<std::size_t>((k + 1) % 3)];
+      if (r.input_label[static_cast<std::size_t>(a)] == Region::kFixed ||
+          r.input_label[static_cast<std::size_t>(b)] == Region::kFixed)
+        continue;
+      longest = std::max(longest, (input_positions.row(a) - input_positions.row(b)).norm());
+    }
+  const double unit =
+      out.base_target_length > 0.0 ? out.base_target_length : mean_edge_length(base);
+  out.support_edge_ratio = unit > 0.0 ? longest / unit : 0.0;
+  out.coarse_support.clear();
+  if (out.support_edge_ratio > kCoarseSupportRatio)
+    out.coarse_support = fmt::format(
+        "the support's own triangles have edges up to {:.0f} times the base's: only their corners "
+        "move, so the support bends in facets (edit a finer tessellation of the part)",
+        out.support_edge_ratio);
   out.negative_weights_in_support = 0;
   for (const auto& [a, b] : negative_edges)
     if (r.base_label[static_cast<std::size_t>(a)] == Region::kFree ||

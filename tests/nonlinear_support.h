@@ -1,6 +1,7 @@
-// The bumpy cylinder of the nonlinear method's tests (tests/test_nonlinear.cpp,
-// tests/test_motion_blend.cpp): the linear method's known failure, a twisted or bent tube that
-// shrinks, measured ring by ring.
+// What the nonlinear method's tests (tests/test_nonlinear.cpp, tests/test_motion_blend.cpp)
+// share: the bumpy cylinder, the linear method's known failure (a twisted or bent tube that
+// shrinks), measured ring by ring; and the bumpy sphere with two caps as handles and nothing
+// fixed, on which one map of both handles must move everything by it.
 #pragma once
 
 #include <algorithm>
@@ -9,11 +10,14 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <gtest/gtest.h>
 
+#include "remora/geometry/measures.h"
+#include "remora/geometry/selection.h"
 #include "remora/mesh/primitives.h"
 #include "remora/multires/editor.h"
 
-namespace remora::cylinder_testing {
+namespace remora::nonlinear_testing {
 
 inline constexpr double kPi = std::numbers::pi;
 
@@ -131,4 +135,57 @@ inline double max_row_distance(const Eigen::MatrixXd& a, const Eigen::MatrixXd& 
   return (a - b).rowwise().norm().maxCoeff();
 }
 
-} // namespace remora::cylinder_testing
+/// A bumpy unit sphere: every vertex in the support, its caps above z = 0.5 and below −0.5 the two
+/// handles, nothing fixed (the weights sum to 1).
+struct CappedSphere {
+  Mesh mesh;
+  std::vector<int> support;
+  std::vector<std::vector<int>> handles;
+  double diagonal = 0.0;
+};
+
+inline CappedSphere capped_sphere() {
+  CappedSphere s;
+  s.mesh = make_icosphere(3, 1.0);
+  for (const VertexHandle v : s.mesh.vertices()) {
+    const Vec3 p = s.mesh.point(v);
+    s.mesh.set_point(v, p * (1.0 + 0.03 * std::sin(9 * p[0]) * std::sin(9 * p[1])));
+    s.support.push_back(v.idx());
+  }
+  s.handles = {select_sphere(s.mesh, Vec3(0, 0, 1), 0.5),
+               select_sphere(s.mesh, Vec3(0, 0, -1), 0.5)};
+  s.diagonal = bounding_box_diagonal(s.mesh);
+  return s;
+}
+
+/// The rigid map of the exact-case tests, and an affine one (that map after a stretch).
+inline Transform some_rigid_map() {
+  return compose(translation({0.4, -0.2, 1.5}), rotation({1, 2, 3}, 2.0, {0.1, 0.2, 0.3}));
+}
+inline Transform some_affine_map() {
+  return compose(some_rigid_map(), scaling({1.5, 0.7, 1.1}, {0.1, 0.0, 0.2}));
+}
+
+/// The rows of p mapped by t.
+inline Eigen::MatrixXd mapped(const Transform& t, const Eigen::MatrixXd& p) {
+  return ((t.leftCols<3>() * p.transpose()).colwise() + t.col(3)).transpose();
+}
+
+/// `editor` holds the capped sphere's region: `t` of both handles moves the base by t, and
+/// (t rigid) the details with it; report().nonlinear.total_iterations stays at most
+/// `max_iterations`.
+inline void expect_one_map_moves_everything(Editor& editor, const CappedSphere& s,
+                                            const Transform& t, int max_iterations,
+                                            const Eigen::MatrixXd& rest) {
+  editor.set_transform(0, t);
+  editor.set_transform(1, t);
+  EXPECT_LT(max_row_distance(editor.base_positions(), mapped(t, rest)), 1e-9 * s.diagonal);
+  EXPECT_TRUE(editor.converged());
+  EXPECT_LE(editor.report().nonlinear.total_iterations, max_iterations);
+  if (t.leftCols<3>().isUnitary(1e-12)) {
+    EXPECT_LT(max_row_distance(editor.positions(), mapped(t, positions_matrix(s.mesh))),
+              1e-9 * s.diagonal);
+  }
+}
+
+} // namespace remora::nonlinear_testing
