@@ -338,6 +338,34 @@ TEST_F(Cli, EditRunsTheDocumentedExamples) {
   EXPECT_LT(difference, 1e-12);
 }
 
+// --refine-support: the support's long edges split (the output has more vertices, the old ones
+// first and where they were outside the support), counted in the report; refused with
+// --no-remesh.
+TEST_F(Cli, EditRefinesTheSupportWhenAsked) {
+  const fs::path in = dir_ / "sphere.off";
+  const Mesh sphere = make_icosphere(3); // radius 1
+  write_mesh(in.string(), sphere);
+  const fs::path out = dir_ / "out.ply";
+  const std::string args = "edit " + in.string() + " -o " + out.string() +
+                           " --support-sphere 0,0,1,0.8 --handle-sphere 0,0,1,0.2"
+                           " --translate 0,0,0.1 --refine-support";
+  const CliRun r = run(args + " --report");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("refined: "), std::string::npos) << r.out;
+  const Mesh result = read_mesh(out.string()).mesh;
+  EXPECT_GT(result.n_vertices(), sphere.n_vertices());
+  for (const VertexHandle v : sphere.vertices())
+    if (sphere.point(v)[2] < 0.0) {
+      EXPECT_LT((result.point(v) - sphere.point(v)).norm(), 1e-6);
+    }
+  fs::remove(out);
+  const CliRun refused = run(args + " --no-remesh");
+  EXPECT_EQ(refused.exit_code, 1);
+  EXPECT_NE(refused.err.find("does not combine with --no-remesh"), std::string::npos)
+      << refused.err;
+  EXPECT_FALSE(fs::exists(out));
+}
+
 TEST_F(Cli, EditRefusesBadRequestsAndWritesNothing) {
   const fs::path in = dir_ / "sphere.off";
   write_mesh(in.string(), make_icosphere(3)); // radius 1

@@ -254,6 +254,11 @@ TEST(Nonlinear, ANeedleCadMeshTurnsWithoutNan) {
     std::cout << rel << ": " << r.free_base_vertices << " free base vertices, "
               << r.nonlinear.iterations << " iterations, converged " << r.nonlinear.converged
               << "\n";
+    // The blended motions on the same region and move: finite, no fall-back.
+    editor.set_nonlinear_energy(NonlinearEnergy::BlendedMotions);
+    EXPECT_TRUE(editor.positions().allFinite()) << rel;
+    EXPECT_TRUE(editor.report().fallback.empty()) << rel << ": " << editor.report().fallback;
+    EXPECT_EQ(editor.report().nonlinear_energy, "blended-motions");
   }
 }
 

@@ -3,7 +3,9 @@
 #include <cmath>
 #include <fstream>
 #include <iostream>
+#include <limits>
 #include <sstream>
+#include <utility>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -15,6 +17,7 @@
 #include "remora/common/timer.h"
 #include "remora/geometry/measures.h"
 #include "remora/mesh/io.h"
+#include "remora/mesh/refine.h"
 #include "remora/multires/detail_retention.h"
 #include "remora/multires/edit_request.h"
 #include "remora/multires/editor.h"
@@ -147,7 +150,7 @@ struct EditArgs {
   int k = 0, threads = 0;
   std::string solver, areas, details, method, energy;
   double base_smoothing = -1, base_feature_cap = -1, length_factor = -1;
-  bool no_remesh = false, report = false, json = false;
+  bool no_remesh = false, report = false, json = false, refine_support = false;
   std::uint64_t max_triangles = 0;
   int max_handles = kMaxHandles;
 };
@@ -200,6 +203,9 @@ void add_edit_options(CLI::App* cmd, EditArgs& a) {
                   "Base remesh edge length = factor x the mean edge length (area-based on needle "
                   "meshes; default 0.9)")
       ->check(CLI::PositiveNumber);
+  cmd->add_flag("--refine-support", a.refine_support,
+                "Split the support's own edges longer than the base's (midpoints: the surface "
+                "stays) so that a coarse CAD support bends smoothly; adds vertices to the output");
   cmd->add_flag("--no-remesh", a.no_remesh,
                 "Solve on the input's own connectivity (the baseline the paper improves on)");
   cmd->add_option("--threads", a.threads, "Worker threads (default: all)")
@@ -310,7 +316,8 @@ Selection select_regions(EditRequest& request, const LoadResult& loaded, const s
 }
 
 /// The figures after the edit: the largest move, and the detail retention in the support.
-void report_edit(const EditArgs& a, Editor& editor, const Selection& s, double load_ms) {
+void report_edit(const EditArgs& a, Editor& editor, const Selection& s, double load_ms,
+                 std::size_t refined) {
   const Mesh& mesh = editor.input();
   const Eigen::MatrixXd input = positions_matrix(mesh);
   const Eigen::MatrixXd& output = editor.positions();
@@ -320,6 +327,7 @@ void report_edit(const EditArgs& a, Editor& editor, const Selection& s, double l
   if (a.json) {
     nlohmann::json j = to_json(editor.report());
     j["milliseconds"]["load"] = load_ms;
+    j["refined_vertices"] = refined;
     j["result"] = {
         {"output", a.out}, {"max_move_relative", max_move}, {"detail_retention", retention}};
     std::cout << dump_json(j, 2) << "\n";
@@ -343,13 +351,31 @@ void run_edit(const EditArgs& a) {
   const LoadResult loaded = read_mesh(a.in, {}, limits);
   const double load_ms = ms_since(t0);
   // Regions first: a bad selection should fail before the preprocessing.
-  const Selection s = select_regions(request, loaded, a.in);
+  Selection s = select_regions(request, loaded, a.in);
+  Mesh mesh = loaded.mesh;
+  std::size_t refined = 0;
+  if (a.refine_support) {
+    if (!options.remesh)
+      throw InvalidArgument("--refine-support splits the support to the remeshed base's edge "
+                            "length; it does not combine with --no-remesh");
+    // The base's edge length on the input as loaded, kept for the refined one.
+    if (options.remesh_options.target_length <= 0.0)
+      options.remesh_options.target_length =
+          options.remesh_options.length_factor * length_scale(mesh).length;
+    // At most as many vertices as --max-triangles allows triangles: the editor's own limit.
+    const std::size_t limit = a.max_triangles > 0 ? static_cast<std::size_t>(a.max_triangles)
+                                                  : std::numeric_limits<std::size_t>::max();
+    const RefineResult r =
+        refine_region(mesh, s.support, options.remesh_options.target_length, limit);
+    s.support = r.region;
+    refined = r.added;
+  }
 
   ProgressLine progress;
   options.progress = [&](std::string_view phase, int step, int steps) {
     progress.update(phase, step, steps);
   };
-  Editor editor(loaded.mesh, options);
+  Editor editor(std::move(mesh), options);
   progress.update("set_region", 0, 1);
   editor.set_region(s.support, s.handles);
   progress.finish();
@@ -361,12 +387,16 @@ void run_edit(const EditArgs& a) {
   const Mesh result = editor.result();
   write_mesh(a.out, result);
   if (a.report || a.json) {
-    report_edit(a, editor, s, load_ms);
+    if (refined > 0 && !a.json)
+      std::cout << "refined: " << grouped(refined) << " vertices added in the support\n";
+    report_edit(a, editor, s, load_ms, refined);
     return;
   }
   std::cout << "wrote " << a.out << " (" << grouped(result.n_vertices()) << " vertices, "
             << grouped(result.n_faces()) << " faces; " << grouped(s.support.size())
-            << " in the support)\n";
+            << " in the support"
+            << (refined > 0 ? fmt::format(", {} added by --refine-support", grouped(refined)) : "")
+            << ")\n";
 }
 
 } // namespace
