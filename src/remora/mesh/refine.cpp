@@ -29,15 +29,15 @@ RefineResult refine_region(Mesh& mesh, const std::vector<int>& region, double ma
   const Mesh before = mesh; // to leave the mesh as it was when the limit is passed
   RefineResult result;
   for (;;) {
-    std::vector<std::pair<double, int>> todo;
+    std::vector<std::pair<double, int>> long_edges;
     for (const EdgeHandle e : mesh.edges())
       if (inside(e)) {
         const double length = mesh.calc_edge_length(e);
-        if (length > max_length) todo.emplace_back(length, e.idx());
+        if (length > max_length) long_edges.emplace_back(length, e.idx());
       }
-    if (todo.empty()) break;
-    std::sort(todo.begin(), todo.end(), std::greater<>());
-    for (const auto& [length, idx] : todo) {
+    if (long_edges.empty()) break;
+    std::sort(long_edges.begin(), long_edges.end(), std::greater<>());
+    for (const auto& [length, idx] : long_edges) {
       const EdgeHandle e(idx); // still one of the edge's halves: split() keeps the handle
       if (mesh.calc_edge_length(e) <= max_length) continue;
       if (mesh.n_vertices() >= max_vertices) {
