@@ -21,6 +21,7 @@
 #include "remora/geometry/selection.h"
 #include "remora/mesh/io.h"
 #include "remora/mesh/primitives.h"
+#include "remora/multires/best_rotation.h"
 #include "remora/multires/editor.h"
 #include "remora/multires/rotation_blend.h"
 

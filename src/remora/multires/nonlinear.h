@@ -132,11 +132,6 @@ private:
   std::unique_ptr<Impl> impl_;
 };
 
-/// The local step's rotation: R maximizing tr(R P) (orthogonal Procrustes), improved from
-/// `start` by power iterations on Horn's quaternion matrix (1987): never worse than `start`, the
-/// best rotation to round-off unless P is nearly degenerate (then it is still no worse).
-Eigen::Matrix3d best_rotation(const Eigen::Matrix3d& p, const Eigen::Matrix3d& start);
-
 std::string to_string(NonlinearEnergy energy);
 /// "arap", "rotated-laplacian", "propagated", "blended-motions"
 NonlinearEnergy parse_nonlinear_energy(const std::string& name);
