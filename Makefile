@@ -11,6 +11,11 @@ CMAKE_FLAGS ?=
 DEMO_MESH  ?= data/bunny.ply
 BENCH_ARGS ?=
 PORT       ?= 8080
+# Unity builds (CMake batches: the library's, the apps' and the test files' groups of
+# tests/CMakeLists.txt, one translation unit each) take half the compile time of a build from
+# scratch; UNITY=OFF compiles every file alone (quicker rebuilds after editing one file, and a
+# missing include is not hidden by an earlier file of its batch).
+UNITY      ?= ON
 # Debian's interpreter, which has Debian's numpy, scipy and pybind11, even when another python3
 # (pyenv, conda) comes first on PATH; the Python module is built for it and tested with it.
 PYTHON     ?= $(firstword $(wildcard /usr/bin/python3) python3)
@@ -35,7 +40,8 @@ deps-web:
 # `remora bench` commands are part of the CLI and always built).
 build: deps
 	cmake -S . -B $(BUILD) -DCMAKE_BUILD_TYPE=Release -DREMORA_WERROR=ON -DREMORA_WITH_CGAL=OFF \
-	  -DREMORA_BUILD_BENCH=OFF -DPython3_EXECUTABLE=$(PYTHON) $(CMAKE_FLAGS)
+	  -DREMORA_BUILD_BENCH=OFF -DPython3_EXECUTABLE=$(PYTHON) -DCMAKE_UNITY_BUILD=$(UNITY) \
+	  $(CMAKE_FLAGS)
 	cmake --build $(BUILD) -j$(JOBS)
 
 # The quality report of the bundled scan, its area-equalizing remesh (paper §4), one edit from
@@ -95,9 +101,6 @@ test-release: build
 # The sanitized build is compiled by clang at -O1 -g1 (line tables only): -O1 -g1 takes 40 % less
 # compile time than -O2 -g on the test files, and clang a third less than GCC under the
 # sanitizers; the same checks, stack traces with file and line, and a second compiler's warnings.
-# The sanitized trees are unity builds (CMake's batches of 8 files; the tests stay one file each):
-# the same code in 40 % less compile time. The release build compiles every file alone, so a
-# missing include still fails there.
 #
 # The tests that ASAN_RELEASE_ONLY matches run in the release build only: numerical figures on
 # large inputs (the shared meshes' remesh suites, but for two CAD parts, gears and featuretype,
@@ -110,7 +113,7 @@ test-asan: deps
 	cmake -S . -B $(ASAN_BUILD) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DREMORA_WERROR=ON \
 	  -DCMAKE_CXX_COMPILER=$(ASAN_CXX) \
 	  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG" -DREMORA_SANITIZE=ON \
-	  -DREMORA_BUILD_BENCH=OFF -DREMORA_BUILD_WEB=OFF -DREMORA_BUILD_FUZZ=ON -DCMAKE_UNITY_BUILD=ON \
+	  -DREMORA_BUILD_BENCH=OFF -DREMORA_BUILD_WEB=OFF -DREMORA_BUILD_FUZZ=ON -DCMAKE_UNITY_BUILD=$(UNITY) \
 	  $(CMAKE_FLAGS)
 	cmake --build $(ASAN_BUILD) -j$(JOBS)
 	cd $(ASAN_BUILD) && $(TEST_ENV) REMORA_SANITIZED=1 ASAN_OPTIONS=detect_leaks=1 \
@@ -126,7 +129,7 @@ test-tsan: deps
 	cmake -S . -B $(TSAN_BUILD) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DREMORA_WERROR=ON \
 	  -DCMAKE_CXX_COMPILER=$(ASAN_CXX) \
 	  -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG" -DREMORA_SANITIZE_THREAD=ON \
-	  -DREMORA_BUILD_BENCH=OFF -DREMORA_BUILD_WEB=OFF -DCMAKE_UNITY_BUILD=ON $(CMAKE_FLAGS)
+	  -DREMORA_BUILD_BENCH=OFF -DREMORA_BUILD_WEB=OFF -DCMAKE_UNITY_BUILD=$(UNITY) $(CMAKE_FLAGS)
 	cmake --build $(TSAN_BUILD) -j$(JOBS) --target remora_tests
 	cd $(TSAN_BUILD) && $(TEST_ENV) REMORA_SANITIZED=1 TSAN_OPTIONS=$(TSAN_OPTIONS_ALL) \
 	  OMP_TOOL_LIBRARIES=$$($(ASAN_CXX) -print-resource-dir)/../../libarcher.so \

@@ -16,10 +16,12 @@
 #include "remora/geometry/selection.h"
 #include "remora/mesh/primitives.h"
 #include "remora/multires/editor.h"
+#include "support.h"
 
 namespace remora::nonlinear_testing {
 
-inline constexpr double kPi = std::numbers::pi;
+using testing::kPi;
+using testing::max_row_distance;
 
 /// An open cylinder of radius 1 and height 4 about the z axis with radial bumps of the given
 /// amplitude: 12 around, wavelength 0.5 along z (8 base edge lengths). The support is every
@@ -129,10 +131,6 @@ inline Flare flare(const Cylinder& c, const Eigen::MatrixXd& linear, const Eigen
   f.top_linear = a.back();
   f.top = b.back();
   return f;
-}
-
-inline double max_row_distance(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
-  return (a - b).rowwise().norm().maxCoeff();
 }
 
 /// A bumpy unit sphere: every vertex in the support, its caps above z = 0.5 and below −0.5 the two

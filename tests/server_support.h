@@ -82,6 +82,11 @@ inline SphereRegion load_sphere_with_region(Session& s, int k = 2) {
 }
 
 /// POST /api/transform of handle 0 with the rows of [M | t]; the response.
+/// GET /api/status, parsed.
+inline nlohmann::json status_of(Session& s) {
+  return nlohmann::json::parse(call(s, "GET", "/api/status").body);
+}
+
 inline HttpResponse move(Session& s, const std::vector<double>& rows) {
   return call(s, "POST", "/api/transform", nlohmann::json{{"handle", 0}, {"matrix", rows}}.dump());
 }

@@ -1,7 +1,12 @@
 // Checks shared by the test files.
 #pragma once
 
+#include <cstdint>
+#include <numbers>
+#include <random>
 #include <sstream>
+
+#include <Eigen/Core>
 
 #include <OpenMesh/Tools/Utils/MeshCheckerT.hh>
 #include <gtest/gtest.h>
@@ -9,6 +14,23 @@
 #include "remora/mesh/mesh.h"
 
 namespace remora::testing {
+
+inline constexpr double kPi = std::numbers::pi;
+
+/// Uniform in [-1, 1).
+inline double symmetric_unit(std::mt19937& rng) {
+  return 2.0 * static_cast<double>(rng()) / 4294967296.0 - 1.0;
+}
+
+/// Each coordinate uniform in [-scale, scale).
+inline Vec3 random_vector(std::mt19937& rng, double scale) {
+  return Vec3(symmetric_unit(rng), symmetric_unit(rng), symmetric_unit(rng)) * scale;
+}
+
+/// The largest distance between corresponding rows of two n×3 matrices.
+inline double max_row_distance(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
+  return (a - b).rowwise().norm().maxCoeff();
+}
 
 /// Signed volume enclosed by the faces (positive for a closed surface facing outward).
 inline double signed_volume(const Mesh& m) {

@@ -18,9 +18,12 @@
 #include "remora/mesh/io.h"
 #include "remora/mesh/primitives.h"
 #include "remora/multires/bake.h"
+#include "support.h"
 
 namespace remora {
 namespace {
+
+using testing::max_row_distance;
 
 EditorOptions two_threads() {
   EditorOptions o;
@@ -29,7 +32,7 @@ EditorOptions two_threads() {
 }
 
 /// A unit sphere of 10,242 vertices with radial bumps.
-Mesh bumpy_sphere() {
+Mesh bumpy_fine_sphere() {
   Mesh m = make_icosphere(5, 1.0);
   for (const VertexHandle v : m.vertices()) {
     const Vec3 p = m.point(v);
@@ -40,11 +43,11 @@ Mesh bumpy_sphere() {
 }
 
 /// The support (geodesic, `count` vertices around `seed`) and its innermost 5 % as the handle.
-struct Region {
+struct BakeRegion {
   std::vector<int> support, handle;
 };
-Region region(const Mesh& mesh, VertexHandle seed, std::size_t count) {
-  Region r;
+BakeRegion region(const Mesh& mesh, VertexHandle seed, std::size_t count) {
+  BakeRegion r;
   r.support = geodesic_order(mesh, seed, count);
   r.handle.assign(r.support.begin(), r.support.begin() + static_cast<long>(count / 20 + 1));
   std::sort(r.support.begin(), r.support.end());
@@ -71,7 +74,7 @@ struct Case {
 
 std::vector<Case> cases() {
   std::vector<Case> out;
-  Mesh sphere = bumpy_sphere();
+  Mesh sphere = bumpy_fine_sphere();
   const VertexHandle top = nearest_vertex(sphere, Vec3(0, 0, 1));
   out.push_back({"sphere", std::move(sphere), top, 1500});
   Mesh bunny = read_mesh(std::string(REMORA_REPO_DATA) + "/bunny.ply").mesh;
@@ -88,10 +91,6 @@ struct PointHash {
            (std::hash<double>()(p[2]) * 97);
   }
 };
-
-double max_row_distance(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
-  return (a - b).rowwise().norm().maxCoeff();
-}
 
 /// Every base vertex lies where its location on the input says (on S'), and every input vertex
 /// is located on the base, near its point of S'.
@@ -120,7 +119,7 @@ TEST(Bake, MatchesAFullPreprocessAndKeepsTheRestBitForBit) {
     SCOPED_TRACE(c.name);
     Editor editor(c.mesh, two_threads());
     const double diagonal = bounding_box_diagonal(c.mesh);
-    const Region r = region(c.mesh, c.seed, c.support);
+    const BakeRegion r = region(c.mesh, c.seed, c.support);
     editor.set_region(r.support, {r.handle});
     editor.set_transform(0, lift(editor, c.seed, 0.04 * diagonal));
     const Eigen::MatrixXd edited = editor.positions();
@@ -135,7 +134,7 @@ TEST(Bake, MatchesAFullPreprocessAndKeepsTheRestBitForBit) {
 
     // The same next edit on both: a support twice as large, lifted the other way. The local
     // bake's editor edits the baked shape: before the move, its positions are O'.
-    const Region next = region(c.mesh, c.seed, 2 * c.support);
+    const BakeRegion next = region(c.mesh, c.seed, 2 * c.support);
     EXPECT_EQ(local.editor.parts().input_positions, edited);
     Eigen::MatrixXd after[2];
     Editor* editors[2] = {&local.editor, &full.editor};
@@ -220,11 +219,11 @@ TEST(Bake, MatchesAFullPreprocessAndKeepsTheRestBitForBit) {
 }
 
 TEST(Bake, FallsBackToTheFullPreprocessWithAReason) {
-  const Mesh mesh = bumpy_sphere();
+  const Mesh mesh = bumpy_fine_sphere();
   Editor editor(mesh, two_threads());
   std::vector<int> all(mesh.n_vertices());
   for (std::size_t i = 0; i < all.size(); ++i) all[i] = static_cast<int>(i);
-  const Region r = region(mesh, VertexHandle(0), 100);
+  const BakeRegion r = region(mesh, VertexHandle(0), 100);
   editor.set_region(all, {r.handle});
   editor.set_transform(0, translation({0.0, 0.0, 0.2}));
   const BakeResult b = bake(editor);

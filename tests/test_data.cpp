@@ -24,7 +24,7 @@ std::string shared_path(const std::string& rel) {
   return std::string(REMORA_SHARED_DATA) + "/" + rel;
 }
 
-struct Expected {
+struct CatalogueEntry {
   const char* path;
   std::size_t vertices;          // referenced vertices in the file (MANIFEST's V)
   std::size_t faces;             // faces in the file (MANIFEST's F)
@@ -35,7 +35,7 @@ struct Expected {
 };
 
 // From ../shared/data/MANIFEST.md.
-const Expected kCatalogue[] = {
+const CatalogueEntry kCatalogue[] = {
     {"cad/conrod.stl", 3223, 6442, 0, 1, 1},
     {"cad/fandisk.obj", 6475, 12946, 0, 1, 1},
     {"cad/featuretype.STL", 2010, 3476, 0, 1, 1},
@@ -53,14 +53,14 @@ const Expected kCatalogue[] = {
 };
 
 // Names the mesh in test listings instead of dumping the struct's bytes.
-void PrintTo(const Expected& e, std::ostream* os) {
+void PrintTo(const CatalogueEntry& e, std::ostream* os) {
   *os << e.path;
 }
 
-class DataCatalogue : public ::testing::TestWithParam<Expected> {};
+class DataCatalogue : public ::testing::TestWithParam<CatalogueEntry> {};
 
 TEST_P(DataCatalogue, EveryFaceIsLoadedOrDroppedWithAReason) {
-  const Expected& e = GetParam();
+  const CatalogueEntry& e = GetParam();
   const std::string path = shared_path(e.path);
   if (!fs::exists(path)) GTEST_SKIP() << path << " not present (../shared/data is optional)";
   const LoadResult r = read_mesh(path);
@@ -86,7 +86,7 @@ TEST_P(DataCatalogue, EveryFaceIsLoadedOrDroppedWithAReason) {
 }
 
 INSTANTIATE_TEST_SUITE_P(SharedData, DataCatalogue, ::testing::ValuesIn(kCatalogue),
-                         [](const ::testing::TestParamInfo<Expected>& param) {
+                         [](const ::testing::TestParamInfo<CatalogueEntry>& param) {
                            std::string label = param.param.path;
                            for (char& c : label)
                              if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';

@@ -21,11 +21,13 @@
 #include "remora/mesh/primitives.h"
 #include "remora/multires/detail_retention.h"
 #include "remora/multires/editor.h"
+#include "support.h"
 
 namespace remora {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
+using testing::kPi;
+using testing::max_row_distance;
 
 /// A unit sphere with radial bumps: detail on a smooth, closed surface.
 Mesh bumpy_sphere(int subdivisions = 4, double amplitude = 0.03) {
@@ -52,10 +54,6 @@ Mesh bumpy_plane(int n, double wavelength, double amplitude) {
 
 std::vector<int> sphere_ids(const Mesh& m, Vec3 c, double r) {
   return select_sphere(m, c, r);
-}
-
-double max_row_distance(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
-  return (a - b).rowwise().norm().maxCoeff();
 }
 
 TEST(Editor, IdentityTransformReproducesTheInput) {

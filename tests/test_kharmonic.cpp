@@ -69,7 +69,7 @@ TEST(KHarmonic, ConstantsAreInTheKernelForEveryKAndWeighting) {
     if (mesh.point(v)[2] > -0.3) region.label[static_cast<std::size_t>(v.idx())] = Region::kFree;
   for (int k = 1; k <= 3; ++k)
     for (AreaWeights w : {AreaWeights::Mixed, AreaWeights::Mean, AreaWeights::MixedSymmetric}) {
-      SCOPED_TRACE(testing::Message() << "k " << k << " " << to_string(w));
+      SCOPED_TRACE(::testing::Message() << "k " << k << " " << to_string(w));
       const KHarmonicSystem s = assemble_kharmonic(mesh, region, {.k = k, .areas = w});
       const Eigen::VectorXd ones_f = Eigen::VectorXd::Ones(s.matrix.rows());
       const Eigen::VectorXd ones_c = Eigen::VectorXd::Ones(s.coupling.cols());
@@ -100,7 +100,7 @@ TEST(KHarmonic, LinearFunctionsAreReproducedOnAFlatMesh) {
   };
   for (int k = 1; k <= 3; ++k)
     for (AreaWeights w : {AreaWeights::Mixed, AreaWeights::Mean, AreaWeights::MixedSymmetric}) {
-      SCOPED_TRACE(testing::Message() << "k " << k << " " << to_string(w));
+      SCOPED_TRACE(::testing::Message() << "k " << k << " " << to_string(w));
       const KHarmonicSystem s = assemble_kharmonic(mesh, region, {.k = k, .areas = w});
       // Mean areas: linear precision needs equal areas, which a jittered mesh has not, except
       // for k = 1, where the areas cancel.
@@ -151,8 +151,8 @@ TEST(KHarmonic, ConvergesToTheRadialSolutionsUnderRefinement) {
         }
         errors.push_back(worst);
       }
-      SCOPED_TRACE(testing::Message() << "k " << k << " " << to_string(w) << " errors " << errors[0]
-                                      << " " << errors[1] << " " << errors[2]);
+      SCOPED_TRACE(::testing::Message() << "k " << k << " " << to_string(w) << " errors "
+                                        << errors[0] << " " << errors[1] << " " << errors[2]);
       // k = 1 converges at second order; k = 2 at first order, since the clamped condition
       // u' = 0 comes from the constrained rings.
       const double rate = k == 1 ? 3.0 : 1.6;
@@ -216,7 +216,7 @@ TEST(KHarmonic, TheAssemblerBuildsTheRowsOfTheDefinition) {
     const Region region = disc_region(mesh, inner, outer);
     for (int k = 1; k <= 3; ++k)
       for (AreaWeights w : {AreaWeights::Mixed, AreaWeights::Mean, AreaWeights::MixedSymmetric}) {
-        SCOPED_TRACE(testing::Message() << "k " << k << " " << to_string(w));
+        SCOPED_TRACE(::testing::Message() << "k " << k << " " << to_string(w));
         const Eigen::MatrixXd s = w == AreaWeights::Mean
                                       ? Eigen::MatrixXd::Identity(n, n)
                                       : Eigen::MatrixXd(area.cwiseInverse().asDiagonal());

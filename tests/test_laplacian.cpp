@@ -17,18 +17,13 @@
 #include "remora/geometry/laplacian.h"
 #include "remora/geometry/measures.h"
 #include "remora/mesh/primitives.h"
+#include "support.h"
 
 namespace remora {
 namespace {
 
-/// Uniform in [-1, 1) from the standard-specified mt19937 sequence (no library distribution).
-double symmetric_unit(std::mt19937& rng) {
-  return 2.0 * static_cast<double>(rng()) / 4294967296.0 - 1.0;
-}
-
-Vec3 random_vector(std::mt19937& rng, double scale) {
-  return Vec3(symmetric_unit(rng), symmetric_unit(rng), symmetric_unit(rng)) * scale;
-}
+using testing::random_vector;
+using testing::symmetric_unit;
 
 /// Every vertex moved randomly by up to `fraction` of the mean edge length in x, y and z (z only
 /// when `flat` is false; boundary vertices stay).

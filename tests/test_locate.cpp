@@ -19,22 +19,17 @@
 #include "remora/geometry/measures.h"
 #include "remora/mesh/primitives.h"
 #include "remora/mesh/surface_point.h"
+#include "support.h"
 
 namespace remora {
 namespace {
 
-/// Uniform in [-1, 1) from the standard-specified mt19937 sequence (no library distribution).
-double symmetric_unit(std::mt19937& rng) {
-  return 2.0 * static_cast<double>(rng()) / 4294967296.0 - 1.0;
-}
+using testing::random_vector;
+using testing::symmetric_unit;
 
 /// Uniform in [0, 1).
 double unit(std::mt19937& rng) {
   return static_cast<double>(rng()) / 4294967296.0;
-}
-
-Vec3 random_vector(std::mt19937& rng, double scale) {
-  return Vec3(symmetric_unit(rng), symmetric_unit(rng), symmetric_unit(rng)) * scale;
 }
 
 /// A random direction times a length uniform in [0, max_length).
@@ -197,7 +192,7 @@ TEST(ClosestPointTriangle, NeverFartherThanDenseSamplingOnRandomTriangles) {
     const Vec3 b = random_vector(rng, 1.0);
     const Vec3 c = random_vector(rng, 1.0);
     for (int k = 0; k < 4; ++k) {
-      SCOPED_TRACE(testing::Message() << "trial " << trial << " point " << k);
+      SCOPED_TRACE(::testing::Message() << "trial " << trial << " point " << k);
       expect_matches_sampling(random_vector(rng, 1.5), a, b, c);
     }
   }
@@ -256,7 +251,7 @@ TEST(ClosestPointTriangle, DegenerateTrianglesMatchDenseSampling) {
     const auto& [a, b, c] = triangles[t];
     const Vec3 centre = (a + b + c) / 3.0;
     for (int k = 0; k < 6; ++k) {
-      SCOPED_TRACE(testing::Message() << "triangle " << t << " point " << k);
+      SCOPED_TRACE(::testing::Message() << "triangle " << t << " point " << k);
       // Half the points close to the triangle, where the needle's width matters.
       const double reach = k % 2 == 0 ? 1.5 : 1e-8;
       expect_matches_sampling(centre + random_vector(rng, reach), a, b, c);

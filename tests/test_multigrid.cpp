@@ -36,7 +36,7 @@ TEST(Multigrid, AgreesWithTheDirectSolverInFewerFineIterationsThanPlainCg) {
   for (int k = 1; k <= 2; ++k)
     for (MultigridMethod method : {MultigridMethod::VCycle, MultigridMethod::Cascadic}) {
       const bool vcycle = method == MultigridMethod::VCycle;
-      SCOPED_TRACE(testing::Message() << "k " << k << (vcycle ? " v-cycle" : " cascadic"));
+      SCOPED_TRACE(::testing::Message() << "k " << k << (vcycle ? " v-cycle" : " cascadic"));
       MultigridSolver multigrid(
           mesh, {.method = method, .k = k, .coarsest_vertices = 300, .tolerance = 1e-12});
       EXPECT_GE(multigrid.levels(), 3u);

@@ -20,9 +20,9 @@
 namespace remora {
 namespace {
 
-using testing::signed_volume;
+using testing::kPi;
 
-constexpr double kPi = std::numbers::pi;
+using testing::signed_volume;
 
 std::array<Vec3, 3> corners(const Mesh& mesh, FaceHandle f) {
   std::array<Vec3, 3> p;

@@ -22,11 +22,13 @@
 #include "remora/geometry/quality.h"
 #include "remora/mesh/io.h"
 #include "remora/mesh/primitives.h"
+#include "support.h"
 
 namespace remora {
 namespace {
 
-constexpr double kPi = std::numbers::pi;
+using testing::kPi;
+using testing::symmetric_unit;
 
 double degrees(double radians) {
   return radians / kPi * 180.0;
@@ -34,11 +36,6 @@ double degrees(double radians) {
 
 double sum(const std::array<double, 3>& values) {
   return values[0] + values[1] + values[2];
-}
-
-/// Uniform in [-1, 1) from the standard-specified mt19937 sequence (no library distribution).
-double symmetric_unit(std::mt19937& rng) {
-  return 2.0 * static_cast<double>(rng()) / 4294967296.0 - 1.0;
 }
 
 /// A uniform grid whose interior vertices are moved randomly in x, y (up to 35 % of a cell) and z.

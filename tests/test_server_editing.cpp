@@ -30,10 +30,6 @@ namespace {
 using nlohmann::json;
 using namespace testing_server;
 
-json status_of(Session& s) {
-  return json::parse(call(s, "GET", "/api/status").body);
-}
-
 TEST(ServerEditing, ANewKKeepsTheMoveWithoutABakeAndUndoComesBack) {
   Session s;
   const SphereRegion r = load_sphere_with_region(s, 2);

@@ -78,10 +78,6 @@ private:
   bool armed_ = false, reached_ = false, open_ = false;
 };
 
-json status_of(Session& s) {
-  return json::parse(call(s, "GET", "/api/status").body);
-}
-
 /// A mesh whose preprocessing lasts long enough to meet requests: an icosphere of 5,120 faces.
 std::string bigger_sphere_ply() {
   return write_mesh_to_memory(make_icosphere(4, 1.0), MeshFormat::Ply, "big.ply");

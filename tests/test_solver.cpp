@@ -56,7 +56,7 @@ TEST(Solver, EverySolverAgreesWithTheDirectOneOnTheSymmetricSystem) {
     for (SolverOptions o : all) {
       o.tolerance = 1e-12;
       auto solver = make_solver(o);
-      SCOPED_TRACE(testing::Message() << solver->name() << " k " << k);
+      SCOPED_TRACE(::testing::Message() << solver->name() << " k " << k);
       solver->compute(s.matrix);
       EXPECT_LE(relative_difference(solver->solve(b), x), 1e-8);
     }

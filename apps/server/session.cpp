@@ -17,7 +17,9 @@
 
 namespace remora::server {
 
-namespace {
+// Named, not anonymous: Session::Impl holds these, and a unity build would otherwise give Impl
+// fields of internal linkage (GCC's -Wsubobject-linkage).
+namespace session_parts {
 
 struct RegionKey {
   std::vector<int> support;
@@ -42,6 +44,12 @@ struct Snapshot {
   std::optional<RegionKey> region;
   std::vector<Transform> transforms;
 };
+
+} // namespace session_parts
+
+using namespace session_parts;
+
+namespace {
 
 /// The movable vertices' rows of `p` as interleaved Float32.
 std::vector<float> movable_floats(const Editor& editor, const Eigen::MatrixXd& p) {
