@@ -7,7 +7,9 @@
 #                                                BUILD/fuzz-seeds/HARNESS); what crashes, leaks,
 #                                                hangs or runs out of memory is kept in
 #                                                BUILD/fuzz-crashes/HARNESS/, the log in
-#                                                BUILD/fuzz-logs/HARNESS.log; a table at the end
+#                                                BUILD/fuzz-logs/HARNESS.log; a table at the end;
+#                                                with FUZZ_RUNS set, each stops after that many
+#                                                executions instead (or at FUZZ_SECONDS)
 #   scripts/fuzz.sh --smoke BUILD HARNESS        the seeds and a fixed number of mutations
 #                                                (FUZZ_RUNS, default per harness) with a fixed
 #                                                random seed, in a fresh corpus: the test of
@@ -82,9 +84,11 @@ for h in "${harnesses[@]}"; do
     crashes="$build/fuzz-crashes/$h"
     log="$build/fuzz-logs/$h.log"
     mkdir -p "$corpus" "$crashes" "$build/fuzz-logs"
-    echo "fuzz: $h for ${seconds} s (log: $log)"
+    echo "fuzz: $h for ${seconds} s${FUZZ_RUNS:+ or $FUZZ_RUNS executions} (log: $log)"
     set +e
-    nice -n "$nice_level" "$exe" "${common[@]}" -max_total_time="$seconds" \
+    limits=(-max_total_time="$seconds")
+    if [ -n "${FUZZ_RUNS:-}" ]; then limits+=(-runs="$FUZZ_RUNS"); fi
+    nice -n "$nice_level" "$exe" "${common[@]}" "${limits[@]}" \
       -artifact_prefix="$crashes/" "$corpus" "$seeds" >"$log" 2>&1
     status=$?
     set -e
