@@ -140,16 +140,18 @@ test-tsan: deps
 # grow in $(FUZZ_BUILD)/fuzz-corpus, crashing inputs are kept in $(FUZZ_BUILD)/fuzz-crashes.
 # ASan records no allocation stacks here (a fifth of the time of a small input); replaying a
 # kept input with the harness alone gives them.
-# FUZZ_HARNESSES picks some (e.g. "obj server"). Runs under nice -n 19. Not part of `make test`.
+# FUZZ_HARNESSES picks some (e.g. "obj server"); FUZZ_RUNS stops each after that many executions
+# (e.g. 10000000 for a long run). Runs under nice -n 19. Not part of `make test`.
 FUZZ_SECONDS   ?= 180
 FUZZ_HARNESSES ?=
+FUZZ_RUNS      ?=
 fuzz: deps
 	cmake -S . -B $(FUZZ_BUILD) -DCMAKE_BUILD_TYPE=RelWithDebInfo -DREMORA_WERROR=ON \
 	  -DCMAKE_CXX_COMPILER=$(ASAN_CXX) -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -g1" \
 	  -DREMORA_SANITIZE=ON -DREMORA_BUILD_FUZZ=ON -DREMORA_FUZZ_COVERAGE=ON \
 	  -DREMORA_BUILD_TESTS=OFF -DREMORA_BUILD_BENCH=OFF -DREMORA_BUILD_WEB=OFF $(CMAKE_FLAGS)
 	cmake --build $(FUZZ_BUILD) -j$(JOBS) --target remora_fuzzers
-	FUZZ_SECONDS=$(FUZZ_SECONDS) ASAN_OPTIONS=detect_leaks=1:malloc_context_size=0 \
+	FUZZ_SECONDS=$(FUZZ_SECONDS) FUZZ_RUNS=$(FUZZ_RUNS) ASAN_OPTIONS=detect_leaks=1:malloc_context_size=0 \
 	  UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 scripts/fuzz.sh $(FUZZ_BUILD) $(FUZZ_HARNESSES)
 
 # The soak of `remora serve` (scripts/soak.py; docs/server.md): SOAK_SECONDS (default 600) of
