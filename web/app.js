@@ -38,7 +38,7 @@ const state = {
   labels: null, positions: null, indices: null, // labels: FIXED, FREE or a handle index per vertex
   movable: null, sentMovable: null, serverHandles: 0, transforms: [], dirtyRegion: false, status: null, frameMs: undefined,
   held: { mesh: undefined, positions: undefined, region: undefined }, // the status ids of what the page holds
-  marks: { paintMove: [], paintTrip: [], drag: [], dragBytes: [], regionReady: [], regionSteps: [], strokeEnd: null, paintable: null },
+  marks: { paintMove: [], paintTrip: [], drag: [], dragBytes: [], dragServer: [], dragTrip: [], dragApply: [], regionReady: [], regionSteps: [], strokeEnd: null, paintable: null },
 };
 const busy = () => state.status?.state === 'busy';
 
@@ -350,6 +350,7 @@ function matrixToRows(m) {
 // the same maps while the pointer rests (POST relax). The answer is the movable vertices' positions.
 const RELAX_PAUSE_MS = 120, RELAX_BUDGET_MS = 40;
 async function sendFrame(request) {
+  request.sent = performance.now();
   // A refused relax (the server busy with a new region) is dropped without a message.
   const response = request.relax
     ? await fetch('api/relax', { method: 'POST', headers: { 'Content-Type': 'application/json' },
@@ -365,10 +366,15 @@ let lastMove = 0, relaxTimer = null;
 const frames = new Coalescer(sendFrame, (result, request) => {
   if (!state.movable || result.moved.length !== 3 * state.movable.length) return;
   state.frameMs = result.ms;
+  const received = performance.now();
   view.applyMoved(state.movable, result.moved);
   if (!request.relax) {
-    state.marks.drag.push(performance.now() - request.t0);
+    const done = performance.now();
+    state.marks.drag.push(done - request.t0);
     state.marks.dragBytes.push(result.bytes);
+    state.marks.dragServer.push(result.ms);
+    state.marks.dragTrip.push(received - request.sent);
+    state.marks.dragApply.push(done - received);
   }
   state.converged = result.converged;
   if (!result.converged) relaxSoon();

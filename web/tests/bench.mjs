@@ -9,7 +9,9 @@
 //                        set_region_ms, the server's part of it, and the rest,
 //                        mouseup_to_gizmo_beyond_set_region_ms;
 //   drag_cycle_ms        one manipulator move to its positions and normals applied, nothing drawn;
-//                        drag_cycle_shown_ms, drawn;
+//                        drag_cycle_shown_ms, drawn; of the hidden cycle: drag_server_ms, the server's
+//                        frame (X-Frame-Ms), drag_round_trip_ms, the request's send to its answer
+//                        read, drag_apply_ms, the positions and normals applied in the page;
 //   bake_ms              a new stroke after a move (the edited shape baked, a new region) until paintable;
 //   bytes_per_frame      the transform answer's size; support_vertices, the region's support.
 // The pointer moves one step per 1/60 s (a browser delivers moves once per display frame). All
@@ -85,7 +87,8 @@ try {
     await drag(page, c.x, c.y - 75, 0, -1, moves, frame);
     await ready(page);
     const mm = await marks();
-    return { ms: mm.drag.slice(from), bytes: mm.dragBytes.slice(from) };
+    return { ms: mm.drag.slice(from), bytes: mm.dragBytes.slice(from), server: mm.dragServer.slice(from),
+             trip: mm.dragTrip.slice(from), apply: mm.dragApply.slice(from) };
   };
   const shown = quick ? { ms: [], bytes: [] } : await dragCycle();
   await page.evaluate(() => window.remora.setDrawing(false));
@@ -108,7 +111,8 @@ try {
     paint_move_shown_ms: round(median(paintMoveShown)), paint_pick_round_trip_ms: round(median(paintTrips)),
     mouseup_to_gizmo_ms: round(mouseupToGizmo), set_region_ms: round(setRegion),
     mouseup_to_gizmo_beyond_set_region_ms: round(setRegion === null ? null : mouseupToGizmo - setRegion),
-    drag_cycle_ms: round(median(hidden.ms)),
+    drag_cycle_ms: round(median(hidden.ms)), drag_server_ms: round(median(hidden.server)),
+    drag_round_trip_ms: round(median(hidden.trip)), drag_apply_ms: round(median(hidden.apply)),
     drag_cycle_shown_ms: round(median(shown.ms)), bake_ms: round(bake),
     bytes_per_frame: median([...shown.bytes, ...hidden.bytes]), support_vertices: support,
     paint_moves: paintMove.length + paintMoveShown.length, drag_frames: hidden.ms.length + shown.ms.length,
