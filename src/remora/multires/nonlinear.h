@@ -117,7 +117,8 @@ public:
   /// guess: the current positions). Resets the iteration's history.
   void set_transforms(const std::vector<AffineMap>& transforms, const RowPoints* guess = nullptr);
   /// Iterates until converged, max_iterations (counted since set_transforms()) or `budget_ms` of
-  /// wall time (at least one iteration unless finished). Returns the stats of this call.
+  /// wall time: at least one iteration unless finished, and another only when it would end within
+  /// the budget, were it as slow as the slowest of this call. Returns the stats of this call.
   const NonlinearStats& solve(double budget_ms = 1e300);
   /// Every base vertex: the free rows as solved, the constrained ones at their values.
   const RowPoints& positions() const;
