@@ -1,4 +1,5 @@
-// Checks shared by the test files.
+// Checks and small helpers shared by the test files (one definition each, so that test files
+// compiled together in a unity group do not define a name twice).
 #pragma once
 
 #include <cstdint>
