@@ -1,14 +1,21 @@
 // One frame of the editor (multires/frame.h): the blend of the basis functions against the dense
-// product, the normals of a region against vertex_normals() of the whole mesh, and the decode
-// against decode_phong(), bit for bit.
+// product, the normals of a region against vertex_normals() of the whole mesh, the decode
+// against decode_phong(), bit for bit; and the frame exported for a client (frame_export.h).
 #include <algorithm>
+#include <array>
+#include <cmath>
 #include <random>
 #include <set>
 
 #include <gtest/gtest.h>
 
+#include "remora/common/error.h"
+#include "remora/geometry/selection.h"
 #include "remora/mesh/primitives.h"
+#include "remora/multires/editor.h"
 #include "remora/multires/frame.h"
+#include "remora/multires/frame_export.h"
+#include "remora/multires/phong_decode.h"
 
 namespace remora {
 namespace {
@@ -119,6 +126,104 @@ TEST(Frame, TheFramesDecodeIsDecodePhongsBitForBit) {
     EXPECT_EQ(Eigen::Vector3d(feet.row(outputs[i])),
               decode_phong(topology, positions, normals, foot) + added[i])
         << i;
+  }
+}
+
+// The region's frame as a client evaluates it (frame_export.h), replayed here from the exported
+// single-precision data with the library's own Phong point: the editor's positions within the
+// round-off of single precision, every movable vertex written once.
+Eigen::MatrixXd replay_export(const FrameExport& f, const std::vector<Transform>& transforms,
+                              std::size_t movable) {
+  const std::size_t local = f.rest.size() / 6, columns = 3 + 4 * std::size_t(f.handles);
+  Eigen::MatrixXd x(local, 3), n(local, 3);
+  for (std::size_t v = 0; v < local; ++v)
+    for (int c = 0; c < 3; ++c) {
+      x(v, c) = f.rest[6 * v + c];
+      n(v, c) = f.rest[6 * v + 3 + c];
+    }
+  Eigen::MatrixXd coefficients(columns, 3);
+  coefficients.topRows<3>().setIdentity();
+  for (int j = 0; j < f.handles; ++j)
+    coefficients.block<4, 3>(3 + 4 * j, 0) = transforms[std::size_t(j)].transpose();
+  for (std::size_t i = 0; i < f.free_local.size(); ++i) {
+    Eigen::RowVectorXd row(columns);
+    for (std::size_t c = 0; c < columns; ++c) row[Eigen::Index(c)] = f.basis[i * columns + c];
+    x.row(f.free_local[i]) = row * coefficients;
+  }
+  for (int j = 0; j < f.handles; ++j)
+    for (std::uint32_t i = f.handle_begin[std::size_t(j)]; i < f.handle_begin[std::size_t(j) + 1];
+         ++i) {
+      const std::uint32_t v = f.handle_local[i];
+      const Transform& t = transforms[std::size_t(j)];
+      x.row(v) = (t.leftCols<3>() * x.row(v).transpose() + t.col(3)).transpose();
+    }
+  const auto corner = [&](std::uint32_t face, int k) { return f.faces[3 * face + std::size_t(k)]; };
+  for (std::size_t i = 0; i < f.normal_vertices.size(); ++i) {
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    for (std::uint32_t r = f.ring_begin[i]; r < f.ring_begin[i + 1]; ++r) {
+      const Eigen::Vector3d p0 = x.row(corner(f.ring[r], 0)).transpose(),
+                            p1 = x.row(corner(f.ring[r], 1)).transpose(),
+                            p2 = x.row(corner(f.ring[r], 2)).transpose();
+      sum += (p1 - p0).cross(p2 - p0);
+    }
+    n.row(f.normal_vertices[i]) =
+        sum.norm() > 0 ? Eigen::Vector3d(sum.normalized()) : Eigen::Vector3d::Zero();
+  }
+  Eigen::MatrixXd out = Eigen::MatrixXd::Constant(Eigen::Index(movable), 3, std::nan(""));
+  for (std::size_t r = 0; r < f.record_face.size(); ++r) {
+    Eigen::Vector3d xs[3], ns[3];
+    for (int k = 0; k < 3; ++k) {
+      xs[k] = x.row(corner(f.record_face[r], k)).transpose();
+      ns[k] = n.row(corner(f.record_face[r], k)).transpose();
+    }
+    const std::array<double, 3> bary = {f.record_bary[3 * r], f.record_bary[3 * r + 1],
+                                        f.record_bary[3 * r + 2]};
+    std::array<double, 3> residual{};
+    const std::int32_t q = f.record_residual[r];
+    if (q >= 0)
+      residual = {f.residuals[3 * std::size_t(q)], f.residuals[3 * std::size_t(q) + 1],
+                  f.residuals[3 * std::size_t(q) + 2]};
+    Eigen::Vector3d p =
+        phong_detail::phong_point(xs, ns, bary, f.record_offset[r], q >= 0 ? &residual : nullptr);
+    if (!f.offsets.empty())
+      p += Eigen::Vector3d(f.offsets[3 * r], f.offsets[3 * r + 1], f.offsets[3 * r + 2]);
+    EXPECT_TRUE(std::isnan(out(f.record_slot[r], 0))) << "slot " << f.record_slot[r] << " twice";
+    out.row(f.record_slot[r]) = p.transpose();
+  }
+  return out;
+}
+
+TEST(FrameExport, ReplayedInSinglePrecisionGivesTheEditorsPositions) {
+  Mesh mesh = make_icosphere(4, 1.0);
+  for (const VertexHandle v : mesh.vertices()) {
+    const Vec3 p = mesh.point(v);
+    mesh.set_point(v, p * (1.0 + 0.03 * std::sin(9 * p[0]) * std::sin(9 * p[1])));
+  }
+  const std::vector<int> support = select_sphere(mesh, Vec3(0, 0, 1), 1.2);
+  const std::vector<std::vector<int>> handles = {select_sphere(mesh, Vec3(0, 0, 1), 0.3),
+                                                 select_sphere(mesh, Vec3(0.707, 0, 0.707), 0.2)};
+  const std::vector<Transform> transforms = {
+      compose(rotation({1, 2, 0.5}, 0.8, {0, 0, 1}), scaling({1.3, 0.8, 1.1}, {0, 0, 1})),
+      translation({0.1, 0.3, -0.2})};
+  for (const DetailMode mode : {DetailMode::Normal, DetailMode::Displacement}) {
+    EditorOptions options;
+    options.details = mode;
+    Editor editor(mesh, options);
+    editor.set_region(support, handles);
+    for (int j = 0; j < 2; ++j) editor.set_transform(j, transforms[std::size_t(j)]);
+    const FrameExport f = frame_export(editor);
+    EXPECT_EQ(f.offsets.empty(), mode == DetailMode::Normal);
+    const std::vector<int>& movable = editor.movable_vertices();
+    const Eigen::MatrixXd replayed = replay_export(f, transforms, movable.size());
+    const Eigen::MatrixXd& p = editor.positions();
+    double worst = 0.0;
+    for (std::size_t i = 0; i < movable.size(); ++i)
+      worst = std::max(worst, (replayed.row(Eigen::Index(i)) - p.row(movable[i])).norm());
+    EXPECT_LT(worst, 1e-5) << "detail mode " << int(mode); // the sphere's diagonal is 3.5
+    EXPECT_GT(worst, 0.0);                                 // single precision is not double
+    // The nonlinear method's frames are not exported.
+    editor.set_method(EditMethod::Nonlinear);
+    EXPECT_THROW(frame_export(editor), InvalidArgument);
   }
 }
 

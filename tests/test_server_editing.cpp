@@ -185,6 +185,53 @@ TEST(ServerEditing, UndoAndRedoThroughLocalBakesAreExact) {
   }
 }
 
+// The region's kernel (GET /api/region/kernel): sections that add up to the body as its header
+// says; served for method linear only. A move answered with "none" is a 204 without positions
+// that moves the server's shape all the same.
+TEST(ServerEditing, TheKernelIsServedForMethodLinearAndAMoveCanGoUnanswered) {
+  Session s;
+  ASSERT_EQ(call(s, "POST", "/api/load", sphere_off(), {{"name", "sphere.off"}}).status, 202);
+  s.wait();
+  expect_error(call(s, "GET", "/api/region/kernel"), 409, "no region");
+  const SphereRegion r = load_sphere_with_region(s);
+  const HttpResponse kernel = call(s, "GET", "/api/region/kernel");
+  ASSERT_EQ(kernel.status, 200) << kernel.body;
+  const auto words = as<std::uint32_t>(kernel);
+  ASSERT_GE(words.size(), 16u);
+  const std::uint32_t handles = words[1], local = words[2], rows = words[3], columns = words[4],
+                      handle_vertices = words[5], faces = words[6], normal_vertices = words[7],
+                      ring = words[8], records = words[9], residuals = words[10],
+                      offsets = words[11];
+  EXPECT_EQ(words[0], 1u);
+  EXPECT_EQ(handles, 1u);
+  EXPECT_EQ(columns, 7u);
+  EXPECT_EQ(records, r.support.size()); // one detail per movable vertex
+  EXPECT_EQ(offsets, 0u);
+  EXPECT_GT(rows, 0u);
+  const std::size_t expected = 16 + 6 * local + rows + rows * columns + handles + 1 +
+                               handle_vertices + 3 * faces + normal_vertices + normal_vertices + 1 +
+                               ring + records * 7 + 3 * residuals;
+  EXPECT_EQ(words.size(), expected);
+  // A move without an answer, then the same move answered: the same positions.
+  const std::vector<double> lift = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0.3};
+  const HttpResponse quiet =
+      call(s, "POST", "/api/transform",
+           nlohmann::json{{"handle", 0}, {"matrix", lift}, {"answer", "none"}}.dump());
+  EXPECT_EQ(quiet.status, 204);
+  EXPECT_TRUE(quiet.body.empty());
+  EXPECT_EQ(status_of(s)["transforms"][0][11], 0.3);
+  EXPECT_EQ(as<float>(move(s, lift)).size(), 3 * r.support.size());
+  expect_error(call(s, "POST", "/api/transform",
+                    nlohmann::json{{"handle", 0}, {"matrix", lift}, {"answer", "all"}}.dump()),
+               400, "answer");
+  // Method nonlinear: its frames stay on the server.
+  const nlohmann::json region = {
+      {"support", r.support}, {"handles", {r.handle}}, {"method", "nonlinear"}};
+  ASSERT_EQ(call(s, "POST", "/api/region", region.dump()).status, 202);
+  s.wait();
+  expect_error(call(s, "GET", "/api/region/kernel"), 409, "nonlinear");
+}
+
 TEST(ServerEditing, MirrorsCollapsesAndNumbersOutOfRangeAreRefused) {
   Session s;
   load_sphere_with_region(s);

@@ -9,6 +9,7 @@ import { ApiError, api, binary, json, message, post, task, waitUntilReady, work 
 import * as view from './view.js';
 import { FIXED, FREE } from './view.js';
 import { Coalescer, faceNormal, pick } from './picking.js';
+import { evaluateKernel, parseKernel } from './kernel.js';
 import * as panels from './panels.js';
 
 const $ = (id) => document.getElementById(id);
@@ -22,6 +23,9 @@ const showUi = params.get('ui') !== '0';
 if (!showUi) document.body.classList.add('no-ui');
 for (const id of ['show-base', 'show-wire', 'show-mesh', 'show-edges'])
   if (params.has(id)) $(id).checked = params.get(id) === '1';
+// Not for rendering: page-frames=0, the drags' frames from the server for method linear too
+// (web/kernel.js evaluates them in the page otherwise).
+const pageFrames = params.get('page-frames') !== '0';
 const areaRange = Number(params.get('area-range')) > 0 ? Number(params.get('area-range')) : 0.2;
 let cameraParam = params.has('camera') ? params.get('camera').split(',').map(Number) : null;
 if (cameraParam && !((cameraParam.length === 6 || cameraParam.length === 9) && cameraParam.every(Number.isFinite))) {
@@ -38,7 +42,7 @@ const state = {
   labels: null, positions: null, indices: null, // labels: FIXED, FREE or a handle index per vertex
   movable: null, sentMovable: null, serverHandles: 0, transforms: [], dirtyRegion: false, status: null, frameMs: undefined,
   held: { mesh: undefined, positions: undefined, region: undefined }, // the status ids of what the page holds
-  marks: { paintMove: [], paintTrip: [], drag: [], dragBytes: [], dragServer: [], dragTrip: [], dragApply: [], regionReady: [], regionSteps: [], strokeEnd: null, paintable: null },
+  marks: { paintMove: [], paintTrip: [], drag: [], dragBytes: [], dragServer: [], dragTrip: [], dragApply: [], dragKernel: [], kernel: [], regionReady: [], regionSteps: [], strokeEnd: null, paintable: null },
 };
 const busy = () => state.status?.state === 'busy';
 
@@ -111,6 +115,43 @@ async function fetchRegion(s, labelsKnown) {
   }
   state.sentMovable = null;
   state.held.region = s.region_id;
+  loadKernel(s);
+}
+
+// ---- the linear method's frames in the page (kernel.js) ------------------------------------------
+// A drag under method linear is evaluated here, from the region's kernel fetched once after the
+// region is ready; the server is sent every map (without an answer) and answers the last one of
+// the drag, whose positions the page then shows. Until the kernel is here, and for the nonlinear
+// methods, the server's answers are the frames.
+let kernel = null; // { regionId, data, out }
+function loadKernel(s) {
+  kernel = null;
+  if (!pageFrames || !s.region || s.region.method !== 'linear' || !state.movable) return;
+  const regionId = s.region_id, movable = state.movable;
+  fetch('api/region/kernel').then((r) => (r.ok ? r.arrayBuffer() : null)).then((buffer) => {
+    if (!buffer || state.held.region !== regionId || state.movable !== movable) return;
+    const data = parseKernel(buffer);
+    kernel = { regionId, data, out: new Float32Array(3 * movable.length) };
+    state.marks.kernel.push({ at: performance.now(), bytes: buffer.byteLength });
+  }).catch((e) => console.warn(`region kernel: ${e.message}; the server's frames are shown`));
+}
+function kernelUsable() {
+  return !!kernel && kernel.regionId === state.held.region && state.method === 'linear' &&
+         !!state.movable && kernel.out.length === 3 * state.movable.length &&
+         state.selected < kernel.data.handles;
+}
+const transformRows = () => state.transforms.map(matrixToRows);
+/// A frame of the drag evaluated in the page; false when it cannot be (then the server's is shown).
+function localFrame(t0) {
+  if (!kernelUsable()) return false;
+  evaluateKernel(kernel.data, transformRows(), kernel.out);
+  const evaluated = performance.now();
+  view.applyMoved(state.movable, kernel.out);
+  const done = performance.now();
+  state.marks.drag.push(done - t0);
+  state.marks.dragKernel.push(evaluated - t0);
+  state.marks.dragApply.push(done - evaluated);
+  return true;
 }
 
 // ---- painting: the server picks, the page colours -----------------------------------------------
@@ -356,7 +397,8 @@ async function sendFrame(request) {
     ? await fetch('api/relax', { method: 'POST', headers: { 'Content-Type': 'application/json' },
                                  body: JSON.stringify({ budget_ms: RELAX_BUDGET_MS }) })
     : await api('transform', { method: 'POST', headers: { 'Content-Type': 'application/json' },
-                               body: JSON.stringify({ handle: request.handle, matrix: request.matrix }) });
+                               body: JSON.stringify({ handle: request.handle, matrix: request.matrix,
+                                                      answer: request.local ? 'none' : 'positions' }) });
   if (!response.ok) throw new ApiError(response.status, 'relax refused');
   const buffer = await response.arrayBuffer();
   return { moved: new Float32Array(buffer), bytes: buffer.byteLength, ms: parseFloat(response.headers.get('X-Frame-Ms')),
@@ -364,11 +406,12 @@ async function sendFrame(request) {
 }
 let lastMove = 0, relaxTimer = null;
 const frames = new Coalescer(sendFrame, (result, request) => {
+  if (request.local) { state.frameMs = result.ms; return; } // shown by localFrame()
   if (!state.movable || result.moved.length !== 3 * state.movable.length) return;
   state.frameMs = result.ms;
   const received = performance.now();
   view.applyMoved(state.movable, result.moved);
-  if (!request.relax) {
+  if (!request.relax && !request.last) {
     const done = performance.now();
     state.marks.drag.push(done - request.t0);
     state.marks.dragBytes.push(result.bytes);
@@ -396,17 +439,21 @@ async function refreshStatus() {
   if (state.status?.nonlinear?.fallback) message(state.status.nonlinear.fallback, 'hint');
 }
 
-let dragStart = null, dragBase = null;
+let dragStart = null, dragBase = null, draggedLocally = false;
 gizmo.addEventListener('dragging-changed', (event) => {
   orbit.enabled = !event.value;
   if (event.value) {
     pivot.updateMatrix();
     dragStart = pivot.matrix.clone().invert();
     dragBase = (state.transforms[state.selected] || new THREE.Matrix4()).clone();
+    draggedLocally = false;
     return;
   }
   dragStart = null;
+  const handle = state.selected, last = draggedLocally;
   task(async () => {
+    // The page showed its own frames: the drag ends on the server's (the reference).
+    if (last) frames.submit({ handle, matrix: matrixToRows(state.transforms[handle]), t0: performance.now(), last: true });
     await frames.idle();
     try { await post('commit'); state.status = await json('status'); panels.showStats(state.status, state.frameMs); } catch (e) { /* shown */ }
     if (baseShown()) await showBase(false);
@@ -420,7 +467,9 @@ gizmo.addEventListener('objectChange', () => {
   const t = pivot.matrix.clone().multiply(dragStart).multiply(dragBase);
   state.transforms[state.selected] = t;
   lastMove = performance.now();
-  frames.submit({ handle: state.selected, matrix: matrixToRows(t), t0: lastMove });
+  const local = localFrame(lastMove);
+  draggedLocally ||= local;
+  frames.submit({ handle: state.selected, matrix: matrixToRows(t), t0: lastMove, local });
 });
 
 // ---- the base surface ---------------------------------------------------------------------------
@@ -527,6 +576,10 @@ window.remora = {
                   cursor: view.cursorShown(), cursorRadius: view.cursorRadius() }),
   labels: () => Array.from(state.labels ?? []),
   positionsHeld: () => state.positions,
+  /// The page's own frame (kernel.js) under `transforms` (per handle the 12 numbers of [M | t]),
+  /// x, y, z per movable vertex; null before the region's kernel is here.
+  kernelFrame: (transforms) => (kernelUsable() ? Array.from(evaluateKernel(kernel.data, transforms, new Float32Array(kernel.out.length))) : null),
+  movableHeld: () => Array.from(state.movable ?? []),
   indicesHeld: () => state.indices,
   tool: () => state.tool,
   selected: () => state.selected,

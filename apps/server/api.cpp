@@ -141,7 +141,14 @@ HttpResponse frame_response(const Frame& f) {
 
 HttpResponse transform(Session& session, const HttpRequest& request, const ApiLimits& limits) {
   const json j = parse_json(request, limits);
-  only_keys(j, {"handle", "matrix"});
+  only_keys(j, {"handle", "matrix", "answer"});
+  bool positions = true;
+  if (j.contains("answer")) {
+    const json& a = j.at("answer");
+    if (!a.is_string() || (a != "positions" && a != "none"))
+      throw BadRequest("answer: expected \"positions\" (the default) or \"none\"");
+    positions = a == "positions";
+  }
   if (!j.contains("handle") || !j.at("handle").is_number_integer())
     throw BadRequest("handle: expected a handle index");
   const json& m = j.contains("matrix") ? j.at("matrix") : json();
@@ -155,7 +162,59 @@ HttpResponse transform(Session& session, const HttpRequest& request, const ApiLi
         throw BadRequest(fmt::format("matrix[{}]: expected a finite number", 4 * r + c));
       t(r, c) = x.get<double>();
     }
-  return frame_response(session.set_transform(j.at("handle").get<int>(), t));
+  HttpResponse r = frame_response(session.set_transform(j.at("handle").get<int>(), t));
+  if (!positions) {
+    r.status = 204;
+    r.body.clear();
+  }
+  return r;
+}
+
+/// The region's linear frame (FrameExport) in one buffer of 4-byte little-endian words: a
+/// header of 16 Uint32 (version 1, handles, local vertices, basis rows, basis columns, handle
+/// vertices, faces, normal vertices, ring length, records, residuals, offsets 0 or 1, 0...),
+/// then rest, free_local, basis, handle_begin, handle_local, faces, normal_vertices, ring_begin,
+/// ring, record_face, record_slot, record_bary, record_offset, record_residual, residuals,
+/// offsets (docs/server.md).
+HttpResponse kernel_response(const FrameExport& f) {
+  const auto count = [](const auto& v) { return static_cast<std::uint32_t>(v.size()); };
+  const std::uint32_t columns = 3 + 4 * static_cast<std::uint32_t>(f.handles);
+  const std::uint32_t header[16] = {1,
+                                    static_cast<std::uint32_t>(f.handles),
+                                    count(f.rest) / 6,
+                                    count(f.free_local),
+                                    columns,
+                                    count(f.handle_local),
+                                    count(f.faces) / 3,
+                                    count(f.normal_vertices),
+                                    count(f.ring),
+                                    count(f.record_face),
+                                    count(f.residuals) / 3,
+                                    f.offsets.empty() ? 0u : 1u};
+  HttpResponse r;
+  r.content_type = "application/octet-stream";
+  const auto append = [&r](const void* data, std::size_t bytes) {
+    if (bytes > 0) r.body.append(static_cast<const char*>(data), bytes);
+  };
+  const auto section = [&append](const auto& v) { append(v.data(), v.size() * sizeof(v[0])); };
+  append(header, sizeof header);
+  section(f.rest);
+  section(f.free_local);
+  section(f.basis);
+  section(f.handle_begin);
+  section(f.handle_local);
+  section(f.faces);
+  section(f.normal_vertices);
+  section(f.ring_begin);
+  section(f.ring);
+  section(f.record_face);
+  section(f.record_slot);
+  section(f.record_bary);
+  section(f.record_offset);
+  section(f.record_residual);
+  section(f.residuals);
+  section(f.offsets);
+  return r;
 }
 
 /// POST /api/relax {"budget_ms": B}: method nonlinear goes on iterating under the live
@@ -266,6 +325,7 @@ HttpResponse dispatch(Session& session, const HttpRequest& q, const ApiLimits& l
   if (p == "/api/base/indices") return get_only(), binary_response(session.base_indices());
   if (p == "/api/base/areas") return get_only(), binary_response(session.base_areas());
   if (p == "/api/region" && get) return json_response(200, session.region());
+  if (p == "/api/region/kernel") return get_only(), kernel_response(session.frame_export());
   if (p == "/api/region") return need("POST", "GET, POST"), region(session, q, limits);
   if (p == "/api/transform") return post_only(), transform(session, q, limits);
   if (p == "/api/relax") return post_only(), relax(session, q, limits);

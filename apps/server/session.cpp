@@ -584,6 +584,16 @@ std::vector<std::uint32_t> Session::movable_vertices() const {
   return {movable.begin(), movable.end()};
 }
 
+FrameExport Session::frame_export() const {
+  std::lock_guard lock(impl_->mutex);
+  const Impl& m = *impl_;
+  m.require_region();
+  if (m.box->editor.options().method != EditMethod::Linear)
+    throw Busy("the region's method is nonlinear: its frames are computed here, not in the "
+               "page (the kernel is served for method linear)");
+  return remora::frame_export(m.box->editor);
+}
+
 std::vector<float> Session::base_positions() const {
   std::lock_guard lock(impl_->mutex);
   const Impl& m = *impl_;

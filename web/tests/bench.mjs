@@ -13,12 +13,17 @@
 //                        frame (X-Frame-Ms), drag_round_trip_ms, the request's send to its answer
 //                        read, drag_apply_ms, the positions and normals applied in the page;
 //   bake_ms              a new stroke after a move (the edited shape baked, a new region) until paintable;
+//                        With method linear the page evaluates the frames itself (web/kernel.js):
+//                        drag_kernel_ms is that evaluation, and there is no server part or round trip
+//                        (--server-frames: the server's frames instead); kernel_bytes, the region's
+//                        kernel, and kernel_after_gizmo_ms, its arrival after the manipulator;
 //   bytes_per_frame      the transform answer's size; support_vertices, the region's support.
 // The pointer moves one step per 1/60 s (a browser delivers moves once per display frame). All
 // medians. The last line printed is one JSON object with these keys.
 //
 //   node web/tests/bench.mjs --cli build/bin/remora --web-root build/web [--mesh data/bunny.ply]
 //        [--support-radius R] [--moves N] [--method linear|nonlinear|blended-motions] [--quick]
+//        [--server-frames]
 // R is in the mesh's units (default: a fifth of its bounding radius); the support is painted at
 // the surface under the view's centre. --method: the page's method switch, set before the support
 // is painted (default linear). --quick: no drawn figures and no bake (their keys are
@@ -27,6 +32,7 @@ import { args, chromiumOrSkip, client, drag, ready, startServer } from './harnes
 
 const moves = Number(args.moves ?? 30);
 const quick = 'quick' in args;
+const serverFrames = 'server-frames' in args;
 // Pointer moves come one per display frame at 60 Hz, as a browser delivers them (it aligns them
 // with its frames), not as fast as the driver can send them.
 const frame = 1000 / 60;
@@ -40,7 +46,7 @@ let failed = false;
 try {
   const page = await browser.newPage({ viewport: { width: 1200, height: 800 } });
   page.on('pageerror', (e) => { console.log('page error:', e.message); failed = true; });
-  await page.goto(url);
+  await page.goto(serverFrames ? url + '?page-frames=0' : url);
   await ready(page, 600000);
   if (args.method) await page.selectOption('#method', args.method);
   const marks = () => page.evaluate(() => window.remora.marks());
@@ -80,16 +86,21 @@ try {
 
   // Drags of the manipulator's arrow, the mesh shown, then hidden.
   const dragCycle = async () => {
-    const from = (await marks()).drag.length;
+    const keys = ['drag', 'dragBytes', 'dragServer', 'dragTrip', 'dragApply', 'dragKernel'];
+    const before = await marks();
     const pivot = await page.evaluate(() => window.remora.pivot());
     const c = await page.evaluate((p) => window.remora.projectPoint(...p), pivot);
     await page.keyboard.press('w');
     await drag(page, c.x, c.y - 75, 0, -1, moves, frame);
     await ready(page);
     const mm = await marks();
-    return { ms: mm.drag.slice(from), bytes: mm.dragBytes.slice(from), server: mm.dragServer.slice(from),
-             trip: mm.dragTrip.slice(from), apply: mm.dragApply.slice(from) };
+    const [ms, bytes, server, trip, apply, kernel] = keys.map((k) => mm[k].slice(before[k].length));
+    return { ms, bytes, server, trip, apply, kernel };
   };
+  // Method linear: the page evaluates the drag's frames once the region's kernel is here.
+  if (!serverFrames && (args.method ?? 'linear') === 'linear')
+    await page.waitForFunction(() => window.remora.kernelFrame([]) !== null, null, { timeout: 120000 }).catch(() => {});
+  const kernelMark = (await marks()).kernel.at(-1);
   const shown = quick ? { ms: [], bytes: [] } : await dragCycle();
   await page.evaluate(() => window.remora.setDrawing(false));
   const hidden = await dragCycle();
@@ -113,6 +124,9 @@ try {
     mouseup_to_gizmo_beyond_set_region_ms: round(setRegion === null ? null : mouseupToGizmo - setRegion),
     drag_cycle_ms: round(median(hidden.ms)), drag_server_ms: round(median(hidden.server)),
     drag_round_trip_ms: round(median(hidden.trip)), drag_apply_ms: round(median(hidden.apply)),
+    drag_kernel_ms: round(median(hidden.kernel)),
+    kernel_after_gizmo_ms: round(kernelMark ? kernelMark.at - m.regionReady[m.regionReady.length - 1] : null),
+    kernel_bytes: kernelMark?.bytes ?? null,
     drag_cycle_shown_ms: round(median(shown.ms)), bake_ms: round(bake),
     bytes_per_frame: median([...shown.bytes, ...hidden.bytes]), support_vertices: support,
     paint_moves: paintMove.length + paintMoveShown.length, drag_frames: hidden.ms.length + shown.ms.length,

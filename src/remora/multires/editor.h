@@ -186,6 +186,8 @@ struct EditorPartsView {
   const EditReport& report;
 };
 
+struct FrameExport;
+
 class Editor {
 public:
   /// Steps 1-3. `mesh` must be a repaired mesh without deleted elements (read_mesh() gives one).
@@ -290,6 +292,7 @@ public:
   EditorPartsView parts() const;
 
 private:
+  friend FrameExport frame_export(const Editor& editor); // multires/frame_export.h
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

@@ -1,0 +1,47 @@
+// The current region's frame (frame.h: blend, normals, Phong decode) as data, for a client that
+// evaluates the linear method's frames itself: the browser page does, so that a drag needs no
+// round trip (web/kernel.js; docs/server.md, `GET /api/region/kernel`). Single precision, in a
+// local numbering of the base: only the base vertices and faces a frame reads.
+//
+// A client's frame, for transforms T_j = [M_j | t_j] (j < handles), with C the (3 + 4h) × 3
+// matrix [I; M_0ᵀ; t_0ᵀ; ...] of editor.h:
+//  1. x = rest positions; x[free_local[i]] = basis row i · C; x[v] = M_j rest[v] + t_j for the
+//     vertices of handle j (handle_local[handle_begin[j] .. handle_begin[j + 1])).
+//  2. n = rest normals; for normal_vertices[i]: the normalized sum over its faces
+//     ring[ring_begin[i] .. ring_begin[i + 1]) of (x1 − x0) × (x2 − x0), (0, 0, 0) where it
+//     vanishes.
+//  3. output slot[r] (an index into Editor::movable_vertices()) = phong_point() of record r on
+//     its face (phong_decode.h), plus offsets[r] when there are offsets.
+// Its results differ from Editor::positions() by the single-precision round-off of the data.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+namespace remora {
+
+class Editor;
+
+struct FrameExport {
+  int handles = 0;
+  /// n_local × 6: B0's position and unit normal (that of normal_vertices is step 2's to compute)
+  std::vector<float> rest;
+  std::vector<std::uint32_t> free_local;   ///< per basis row, its local vertex
+  std::vector<float> basis;                ///< n_free × (3 + 4 handles), row-major
+  std::vector<std::uint32_t> handle_begin; ///< handles + 1 offsets into handle_local
+  std::vector<std::uint32_t> handle_local; ///< the handles' local vertices
+  std::vector<std::uint32_t> faces;        ///< n_faces × 3 local vertices
+  std::vector<std::uint32_t> normal_vertices, ring_begin, ring; ///< step 2 (ring: local faces)
+  std::vector<std::uint32_t> record_face, record_slot;          ///< per record
+  std::vector<float> record_bary;           ///< per record, 3 barycentric coordinates
+  std::vector<float> record_offset;         ///< per record, the offset along the normal
+  std::vector<std::int32_t> record_residual; ///< per record, an index into residuals, or −1
+  std::vector<float> residuals;              ///< 3 per residual, in the face's frame
+  std::vector<float> offsets;                ///< 3 per record, or empty
+};
+
+/// The editor's current region as a FrameExport. Throws InvalidArgument without a region or
+/// when the editor's method is not linear (the nonlinear frames are the server's).
+FrameExport frame_export(const Editor& editor);
+
+} // namespace remora
