@@ -44,12 +44,15 @@ export function parseKernel(buffer) {
   let ringFaces = 0;
   for (let i = 0; i < k.ring.length; ++i) ringFaces = Math.max(ringFaces, k.ring[i] + 1);
   k.ringFaces = ringFaces; // the normals' faces come first among the faces
-  // The frame's working rows: positions and normals in double precision, at rest to begin with
-  // (rows that no frame writes keep them).
-  k.x = new Float64Array(3 * local);
-  k.n = new Float64Array(3 * local);
-  for (let v = 0; v < local; ++v)
-    for (let c = 0; c < 3; ++c) { k.x[3 * v + c] = k.rest[6 * v + c]; k.n[3 * v + c] = k.rest[6 * v + 3 + c]; }
+  // The frame's working rows, a vertex's position and normal side by side (one cache line read per
+  // corner), in double precision, at rest to begin with (rows that no frame writes keep them); the
+  // faces' corners as offsets into them.
+  k.xn = Float64Array.from(k.rest);
+  k.faceRows = new Uint32Array(3 * ringFaces);
+  for (let i = 0; i < k.faceRows.length; ++i) k.faceRows[i] = 6 * k.faces[i];
+  k.recordRows = new Uint32Array(3 * records);
+  for (let r = 0; r < records; ++r)
+    for (let c = 0; c < 3; ++c) k.recordRows[3 * r + c] = 6 * k.faces[3 * k.recordFace[r] + c];
   k.cross = new Float64Array(3 * ringFaces);
   k.coefficients = new Float64Array(3 * columns);
   return k;
@@ -70,7 +73,7 @@ const IDENTITY = [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0];
 /// Step 1: the basis rows times C = [I; M_0ᵀ; t_0ᵀ; ...], and the handles' own vertices moved
 /// rigidly with their maps.
 function blend(k, transforms) {
-  const { columns, basis, freeLocal, rows, x, rest, coefficients: C } = k;
+  const { columns, basis, freeLocal, rows, xn: x, rest, coefficients: C } = k;
   C.fill(0);
   C[0] = C[4] = C[8] = 1;
   for (let j = 0; j < k.handles; ++j) {
@@ -84,25 +87,25 @@ function blend(k, transforms) {
       const w = basis[b];
       px += w * C[3 * c]; py += w * C[3 * c + 1]; pz += w * C[3 * c + 2];
     }
-    const v = 3 * freeLocal[i];
+    const v = 6 * freeLocal[i];
     x[v] = px; x[v + 1] = py; x[v + 2] = pz;
   }
   for (let j = 0; j < k.handles; ++j) {
     const t = transforms[j] ?? IDENTITY;
     for (let i = k.handleBegin[j]; i < k.handleBegin[j + 1]; ++i) {
       const v = k.handleLocal[i], rx = rest[6 * v], ry = rest[6 * v + 1], rz = rest[6 * v + 2];
-      x[3 * v] = t[0] * rx + t[1] * ry + t[2] * rz + t[3];
-      x[3 * v + 1] = t[4] * rx + t[5] * ry + t[6] * rz + t[7];
-      x[3 * v + 2] = t[8] * rx + t[9] * ry + t[10] * rz + t[11];
+      x[6 * v] = t[0] * rx + t[1] * ry + t[2] * rz + t[3];
+      x[6 * v + 1] = t[4] * rx + t[5] * ry + t[6] * rz + t[7];
+      x[6 * v + 2] = t[8] * rx + t[9] * ry + t[10] * rz + t[11];
     }
   }
 }
 
 /// Step 2: the normals that can change, the normalized sums of their faces' cross products.
 function normals(k) {
-  const { faces, x, n, cross } = k;
-  for (let f = 0; f < k.ringFaces; ++f) {
-    const a = 3 * faces[3 * f], b = 3 * faces[3 * f + 1], c = 3 * faces[3 * f + 2];
+  const { faceRows, xn: x, cross, ringFaces } = k;
+  for (let f = 0; f < ringFaces; ++f) {
+    const a = faceRows[3 * f], b = faceRows[3 * f + 1], c = faceRows[3 * f + 2];
     const ux = x[b] - x[a], uy = x[b + 1] - x[a + 1], uz = x[b + 2] - x[a + 2];
     const vx = x[c] - x[a], vy = x[c + 1] - x[a + 1], vz = x[c + 2] - x[a + 2];
     cross[3 * f] = uy * vz - uz * vy; cross[3 * f + 1] = uz * vx - ux * vz; cross[3 * f + 2] = ux * vy - uy * vx;
@@ -110,29 +113,28 @@ function normals(k) {
   const { normalVertices, ringBegin, ring } = k;
   for (let i = 0; i < normalVertices.length; ++i) {
     let sx = 0, sy = 0, sz = 0;
-    for (let r = ringBegin[i]; r < ringBegin[i + 1]; ++r) {
+    for (let r = ringBegin[i], end = ringBegin[i + 1]; r < end; ++r) {
       const s = 3 * ring[r];
       sx += cross[s]; sy += cross[s + 1]; sz += cross[s + 2];
     }
-    const len = Math.sqrt(sx * sx + sy * sy + sz * sz), v = 3 * normalVertices[i];
+    const len = Math.sqrt(sx * sx + sy * sy + sz * sz), v = 6 * normalVertices[i] + 3;
     const scale = len > 0 ? 1 / len : 0;
-    n[v] = sx * scale; n[v + 1] = sy * scale; n[v + 2] = sz * scale;
+    x[v] = sx * scale; x[v + 1] = sy * scale; x[v + 2] = sz * scale;
   }
 }
 
 /// Step 3: each detail on its base face: b + offset n̂(b), plus its residual in the face's frame.
 function decode(k, out) {
-  const { faces, x, n, recordFace, recordSlot, recordBary, recordOffset, recordResidual, residuals, offsets } = k;
-  for (let r = 0; r < k.records; ++r) {
-    const f = 3 * recordFace[r];
-    const a = 3 * faces[f], b = 3 * faces[f + 1], c = 3 * faces[f + 2];
+  const { recordRows, xn: x, recordSlot, recordBary, recordOffset, recordResidual, residuals, offsets, records } = k;
+  for (let r = 0; r < records; ++r) {
+    const a = recordRows[3 * r], b = recordRows[3 * r + 1], c = recordRows[3 * r + 2];
     const wa = recordBary[3 * r], wb = recordBary[3 * r + 1], wc = recordBary[3 * r + 2];
     let px = wa * x[a] + wb * x[b] + wc * x[c];
     let py = wa * x[a + 1] + wb * x[b + 1] + wc * x[c + 1];
     let pz = wa * x[a + 2] + wb * x[b + 2] + wc * x[c + 2];
-    const nx = wa * n[a] + wb * n[b] + wc * n[c];
-    const ny = wa * n[a + 1] + wb * n[b + 1] + wc * n[c + 1];
-    const nz = wa * n[a + 2] + wb * n[b + 2] + wc * n[c + 2];
+    const nx = wa * x[a + 3] + wb * x[b + 3] + wc * x[c + 3];
+    const ny = wa * x[a + 4] + wb * x[b + 4] + wc * x[c + 4];
+    const nz = wa * x[a + 5] + wb * x[b + 5] + wc * x[c + 5];
     const len = Math.sqrt(nx * nx + ny * ny + nz * nz);
     if (len > 0) {
       const s = recordOffset[r] / len;
