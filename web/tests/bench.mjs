@@ -16,7 +16,8 @@
 //                        With method linear the page evaluates the frames itself (web/kernel.js):
 //                        drag_kernel_ms is that evaluation, and there is no server part or round trip
 //                        (--server-frames: the server's frames instead); kernel_bytes, the region's
-//                        kernel, and kernel_after_gizmo_ms, its arrival after the manipulator;
+//                        kernel, and kernel_after_mouseup_ms, its arrival after the handle stroke's
+//                        mouse-up (compare mouseup_to_gizmo_ms);
 //   bytes_per_frame      the transform answer's size; support_vertices, the region's support.
 // The pointer moves one step per 1/60 s (a browser delivers moves once per display frame). All
 // medians. The last line printed is one JSON object with these keys.
@@ -100,7 +101,8 @@ try {
   // Method linear: the page evaluates the drag's frames once the region's kernel is here.
   if (!serverFrames && (args.method ?? 'linear') === 'linear')
     await page.waitForFunction(() => window.remora.kernelFrame([]) !== null, null, { timeout: 120000 }).catch(() => {});
-  const kernelMark = (await marks()).kernel.at(-1);
+  const afterKernel = await marks();
+  const kernelMark = afterKernel.kernel.at(-1);
   const shown = quick ? { ms: [], bytes: [] } : await dragCycle();
   await page.evaluate(() => window.remora.setDrawing(false));
   const hidden = await dragCycle();
@@ -125,7 +127,7 @@ try {
     drag_cycle_ms: round(median(hidden.ms)), drag_server_ms: round(median(hidden.server)),
     drag_round_trip_ms: round(median(hidden.trip)), drag_apply_ms: round(median(hidden.apply)),
     drag_kernel_ms: round(median(hidden.kernel)),
-    kernel_after_gizmo_ms: round(kernelMark ? kernelMark.at - m.regionReady[m.regionReady.length - 1] : null),
+    kernel_after_mouseup_ms: round(kernelMark ? kernelMark.at - afterKernel.strokeEnd : null),
     kernel_bytes: kernelMark?.bytes ?? null,
     drag_cycle_shown_ms: round(median(shown.ms)), bake_ms: round(bake),
     bytes_per_frame: median([...shown.bytes, ...hidden.bytes]), support_vertices: support,
