@@ -51,7 +51,8 @@ FrameExport frame_export(const Editor& editor) {
   out.handles = r.handles;
 
   // Faces: the normals' faces first (ring indexes them as they are), then the decode's.
-  LocalIds face_ids(m.topology.faces.size()), vertex_ids(static_cast<std::size_t>(m.base_rest.rows()));
+  LocalIds face_ids(m.topology.faces.size()),
+      vertex_ids(static_cast<std::size_t>(m.base_rest.rows()));
   for (const int f : plan.faces) face_ids(f);
   out.record_face.reserve(details.records.size());
   for (const FrameDetails::Record& rec : details.records)

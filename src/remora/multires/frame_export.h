@@ -33,8 +33,8 @@ struct FrameExport {
   std::vector<std::uint32_t> faces;        ///< n_faces × 3 local vertices
   std::vector<std::uint32_t> normal_vertices, ring_begin, ring; ///< step 2 (ring: local faces)
   std::vector<std::uint32_t> record_face, record_slot;          ///< per record
-  std::vector<float> record_bary;           ///< per record, 3 barycentric coordinates
-  std::vector<float> record_offset;         ///< per record, the offset along the normal
+  std::vector<float> record_bary;            ///< per record, 3 barycentric coordinates
+  std::vector<float> record_offset;          ///< per record, the offset along the normal
   std::vector<std::int32_t> record_residual; ///< per record, an index into residuals, or −1
   std::vector<float> residuals;              ///< 3 per residual, in the face's frame
   std::vector<float> offsets;                ///< 3 per record, or empty
