@@ -186,9 +186,9 @@ TEST(ServerEditing, UndoAndRedoThroughLocalBakesAreExact) {
 }
 
 // The region's kernel (GET /api/region/kernel): sections that add up to the body as its header
-// says; served for method linear only. A move answered with "none" is a 204 without positions
+// says; served for method linear and the energy blended-motions only. A move answered with "none" is a 204 without positions
 // that moves the server's shape all the same.
-TEST(ServerEditing, TheKernelIsServedForMethodLinearAndAMoveCanGoUnanswered) {
+TEST(ServerEditing, TheKernelIsServedForFramesThatDoNotIterateAndAMoveCanGoUnanswered) {
   Session s;
   ASSERT_EQ(call(s, "POST", "/api/load", sphere_off(), {{"name", "sphere.off"}}).status, 202);
   s.wait();
@@ -230,6 +230,17 @@ TEST(ServerEditing, TheKernelIsServedForMethodLinearAndAMoveCanGoUnanswered) {
   ASSERT_EQ(call(s, "POST", "/api/region", region.dump()).status, 202);
   s.wait();
   expect_error(call(s, "GET", "/api/region/kernel"), 409, "nonlinear");
+  // But for the energy blended-motions, which does not iterate.
+  const nlohmann::json blended = {{"support", r.support},
+                                  {"handles", {r.handle}},
+                                  {"method", "nonlinear"},
+                                  {"energy", "blended-motions"}};
+  ASSERT_EQ(call(s, "POST", "/api/region", blended.dump()).status, 202);
+  s.wait();
+  const HttpResponse blended_kernel = call(s, "GET", "/api/region/kernel");
+  ASSERT_EQ(blended_kernel.status, 200) << blended_kernel.body;
+  EXPECT_EQ(as<std::uint32_t>(blended_kernel)[12], 1u);
+  EXPECT_EQ(words[12], 0u);
 }
 
 TEST(ServerEditing, MirrorsCollapsesAndNumbersOutOfRangeAreRefused) {

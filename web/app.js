@@ -118,15 +118,16 @@ async function fetchRegion(s, labelsKnown) {
   loadKernel(s);
 }
 
-// ---- the linear method's frames in the page (kernel.js) ------------------------------------------
-// A drag under method linear is evaluated here, from the region's kernel fetched once after the
+// ---- the frames of method linear and of blended motions in the page (kernel.js) ------------------
+// A drag under method linear or the energy blended-motions is evaluated here, from the region's kernel fetched once after the
 // region is ready; the server is sent every map (without an answer) and answers the last one of
 // the drag, whose positions the page then shows. Until the kernel is here, and for the nonlinear
-// methods, the server's answers are the frames.
+// energies that iterate, the server's answers are the frames.
 let kernel = null; // { regionId, data, out }
 function loadKernel(s) {
   kernel = null;
-  if (!pageFrames || !s.region || s.region.method !== 'linear' || !state.movable) return;
+  const computable = s.region?.method === 'linear' || s.region?.energy === 'blended-motions';
+  if (!pageFrames || !computable || !state.movable) return;
   const regionId = s.region_id, movable = state.movable;
   fetch('api/region/kernel').then((r) => (r.ok ? r.arrayBuffer() : null)).then((buffer) => {
     if (!buffer || state.held.region !== regionId || state.movable !== movable) return;
@@ -136,7 +137,7 @@ function loadKernel(s) {
   }).catch((e) => console.warn(`region kernel: ${e.message}; the server's frames are shown`));
 }
 function kernelUsable() {
-  return !!kernel && kernel.regionId === state.held.region && state.method === 'linear' &&
+  return !!kernel && kernel.regionId === state.held.region && (state.method === 'linear' || state.method === 'blended-motions') &&
          !!state.movable && kernel.out.length === 3 * state.movable.length &&
          state.selected < kernel.data.handles;
 }

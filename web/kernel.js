@@ -1,9 +1,10 @@
-// The linear method's frame evaluated in the page, so that a drag waits for no round trip: the
-// blend of the basis functions, the base's normals where they can change and the Phong decode,
-// the same steps and formulas as the server's frame (src/remora/multires/frame.h,
-// frame_export.h, phong_decode.h) on the data of `GET /api/region/kernel` (single precision).
-// The server stays the reference: the page sends every map to it and shows its answer at the
-// end of a drag; web/tests/e2e.mjs checks that both agree.
+// The frames of method linear and of the nonlinear energy blended-motions evaluated in the page,
+// so that a drag waits for no round trip: the blend of the basis functions (or of the handles'
+// motions), the base's normals where they can change and the Phong decode, the same steps and
+// formulas as the server's frame (src/remora/multires/frame.h, frame_export.h, motion_blend.h,
+// phong_decode.h) on the data of `GET /api/region/kernel` (single precision). The server stays
+// the reference: the page sends every map to it and shows its answer at the end of a drag;
+// web/tests/e2e.mjs checks that both agree.
 
 const HEADER_WORDS = 16;
 
@@ -12,7 +13,7 @@ const HEADER_WORDS = 16;
 export function parseKernel(buffer) {
   const header = new Uint32Array(buffer, 0, HEADER_WORDS);
   const [version, handles, local, rows, columns, handleVertices, faces, normalVertices, ringLength,
-    records, residuals, hasOffsets] = header;
+    records, residuals, hasOffsets, blended] = header;
   if (version !== 1) throw new Error(`region kernel: version ${version}, expected 1`);
   let at = 4 * HEADER_WORDS;
   const take = (Type, n) => {
@@ -21,7 +22,7 @@ export function parseKernel(buffer) {
     return view;
   };
   const k = {
-    handles, local, rows, columns, records,
+    handles, local, rows, columns, records, blended: blended === 1,
     rest: take(Float32Array, 6 * local),
     freeLocal: take(Uint32Array, rows),
     basis: take(Float32Array, rows * columns),
@@ -55,6 +56,14 @@ export function parseKernel(buffer) {
     for (let c = 0; c < 3; ++c) k.recordRows[3 * r + c] = 6 * k.faces[3 * k.recordFace[r] + c];
   k.cross = new Float64Array(3 * ringFaces);
   k.coefficients = new Float64Array(3 * columns);
+  // Blended motions: the handles' pivots, the centroids of their rest positions.
+  k.pivots = [];
+  for (let j = 0; j < handles; ++j) {
+    const o = [0, 0, 0], count = k.handleBegin[j + 1] - k.handleBegin[j];
+    for (let i = k.handleBegin[j]; i < k.handleBegin[j + 1]; ++i)
+      for (let c = 0; c < 3; ++c) o[c] += k.rest[6 * k.handleLocal[i] + c] / count;
+    k.pivots.push(o);
+  }
   return k;
 }
 
@@ -62,7 +71,8 @@ export function parseKernel(buffer) {
 /// (Float32Array, 3 per movable vertex) under `transforms`: per handle the 12 numbers of the rows
 /// of [M | t] (identity for a missing one).
 export function evaluateKernel(k, transforms, out) {
-  blend(k, transforms);
+  if (k.blended) blendMotions(k, transforms);
+  else blend(k, transforms);
   normals(k);
   decode(k, out);
   return out;
@@ -70,10 +80,125 @@ export function evaluateKernel(k, transforms, out) {
 
 const IDENTITY = [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0];
 
+/// Step 1 of the nonlinear energy blended-motions (motion_blend.h): each free vertex p goes to
+/// exp(Σ_j w_j log G_j) applied to p + Σ_j w_j (S_j − I)(p − o_j), w_j its handle weights (the
+/// basis's "1" columns); the handles' own vertices move with their maps as in blend().
+function blendMotions(k, transforms) {
+  const { columns, basis, freeLocal, rows, xn: x, rest, handles } = k; // rest: 6 per local vertex
+  const motions = [];
+  for (let j = 0; j < handles; ++j) motions.push(handleMotion(transforms[j] ?? IDENTITY, k.pivots[j]));
+  const stretched = motions.some((m) => m.stretched);
+  for (let i = 0; i < rows; ++i) {
+    const v = 6 * freeLocal[i], px = rest[v], py = rest[v + 1], pz = rest[v + 2];
+    let wx = 0, wy = 0, wz = 0, ux = 0, uy = 0, uz = 0, yx = px, yy = py, yz = pz;
+    for (let j = 0; j < handles; ++j) {
+      const w = basis[i * columns + 3 + 4 * j + 3], m = motions[j];
+      wx += w * m.omega[0]; wy += w * m.omega[1]; wz += w * m.omega[2];
+      ux += w * m.v[0]; uy += w * m.v[1]; uz += w * m.v[2];
+      if (stretched) {
+        const S = m.stretch, dx = px - m.pivot[0], dy = py - m.pivot[1], dz = pz - m.pivot[2];
+        yx += w * ((S[0] - 1) * dx + S[1] * dy + S[2] * dz);
+        yy += w * (S[3] * dx + (S[4] - 1) * dy + S[5] * dz);
+        yz += w * (S[6] * dx + S[7] * dy + (S[8] - 1) * dz);
+      }
+    }
+    screwApply([wx, wy, wz], [ux, uy, uz], [yx, yy, yz], x, v);
+  }
+  moveHandles(k, transforms);
+}
+
+/// A handle's map M = R S (polar) split at its pivot o into the stretch about o and the rigid
+/// motion G(y) = R y + t + R (S − I) o, as handle_motions() does; G as the twist (omega, v).
+function handleMotion(t, pivot) {
+  const M = [t[0], t[1], t[2], t[4], t[5], t[6], t[8], t[9], t[10]];
+  const R = polarRotation(M);
+  const S = mul(transpose(R), M); // R⁻¹ M
+  for (let r = 0; r < 3; ++r) for (let c = r + 1; c < 3; ++c) S[3 * r + c] = S[3 * c + r] = 0.5 * (S[3 * r + c] + S[3 * c + r]);
+  const d = [0, 1, 2].map((r) => (S[3 * r] - (r === 0)) * pivot[0] + (S[3 * r + 1] - (r === 1)) * pivot[1] + (S[3 * r + 2] - (r === 2)) * pivot[2]);
+  const tr = [0, 1, 2].map((r) => t[4 * r + 3] + R[3 * r] * d[0] + R[3 * r + 1] * d[1] + R[3 * r + 2] * d[2]);
+  const omega = rotationLog(R);
+  const theta = Math.hypot(...omega);
+  // V⁻¹ t = t − W t / 2 + c W² t, c = (1 − θ sin θ / (2 (1 − cos θ))) / θ² (screw_log()).
+  const c = theta < 1e-4 ? 1 / 12 + (theta * theta) / 720 : (1 - (theta * Math.sin(theta)) / (2 * (1 - Math.cos(theta)))) / (theta * theta);
+  const wt = cross(omega, tr), wwt = cross(omega, wt);
+  const v = [0, 1, 2].map((r) => tr[r] - 0.5 * wt[r] + c * wwt[r]);
+  let stretched = false;
+  for (let r = 0; r < 3; ++r) for (let q = 0; q < 3; ++q) if (Math.abs(S[3 * r + q] - (r === q)) > 1e-12) stretched = true;
+  return { omega, v, stretch: S, pivot, stretched };
+}
+
+/// exp(twist (w, v)) applied to y, into x[at .. at + 2] (screw_apply()).
+function screwApply(w, v, y, x, at) {
+  const theta = Math.hypot(w[0], w[1], w[2]);
+  let a, b, s;
+  if (theta < 1e-4) {
+    const t2 = theta * theta;
+    a = 0.5 - t2 / 24; b = 1 / 6 - t2 / 120; s = 1 - t2 / 6;
+  } else {
+    a = (1 - Math.cos(theta)) / (theta * theta); b = (theta - Math.sin(theta)) / (theta * theta * theta);
+    s = Math.sin(theta) / theta;
+  }
+  const wy = cross(w, y), wwy = cross(w, wy), wv = cross(w, v), wwv = cross(w, wv);
+  for (let c = 0; c < 3; ++c) x[at + c] = y[c] + s * wy[c] + a * wwy[c] + v[c] + a * wv[c] + b * wwv[c];
+}
+
+/// The rotation of the polar decomposition of M (3×3 row-major, det M > 0): Higham's iteration
+/// R ← (R + R⁻ᵀ) / 2, which converges quadratically to it.
+function polarRotation(M) {
+  let R = M.slice();
+  for (let i = 0; i < 50; ++i) {
+    const inverse = inverseTranspose(R), next = R.map((r, q) => 0.5 * (r + inverse[q]));
+    let change = 0;
+    for (let q = 0; q < 9; ++q) change = Math.max(change, Math.abs(next[q] - R[q]));
+    R = next;
+    if (change < 1e-15) break;
+  }
+  return R;
+}
+
+/// The rotation vector of R (angle in [0, π]), through its unit quaternion (rotation_log()).
+function rotationLog(R) {
+  const trace = R[0] + R[4] + R[8];
+  let w, x, y, z;
+  if (trace > 0) {
+    const s = 2 * Math.sqrt(trace + 1);
+    w = s / 4; x = (R[7] - R[5]) / s; y = (R[2] - R[6]) / s; z = (R[3] - R[1]) / s;
+  } else if (R[0] > R[4] && R[0] > R[8]) {
+    const s = 2 * Math.sqrt(1 + R[0] - R[4] - R[8]);
+    w = (R[7] - R[5]) / s; x = s / 4; y = (R[1] + R[3]) / s; z = (R[2] + R[6]) / s;
+  } else if (R[4] > R[8]) {
+    const s = 2 * Math.sqrt(1 + R[4] - R[0] - R[8]);
+    w = (R[2] - R[6]) / s; x = (R[1] + R[3]) / s; y = s / 4; z = (R[5] + R[7]) / s;
+  } else {
+    const s = 2 * Math.sqrt(1 + R[8] - R[0] - R[4]);
+    w = (R[3] - R[1]) / s; x = (R[2] + R[6]) / s; y = (R[5] + R[7]) / s; z = s / 4;
+  }
+  if (w < 0) { w = -w; x = -x; y = -y; z = -z; }
+  const s = Math.hypot(x, y, z);
+  if (s < 1e-300) return [0, 0, 0];
+  const angle = 2 * Math.atan2(s, w);
+  return [x * (angle / s), y * (angle / s), z * (angle / s)];
+}
+
+const cross = (a, b) => [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
+const transpose = (A) => [A[0], A[3], A[6], A[1], A[4], A[7], A[2], A[5], A[8]];
+function mul(A, B) {
+  const C = new Array(9).fill(0);
+  for (let r = 0; r < 3; ++r) for (let c = 0; c < 3; ++c) for (let q = 0; q < 3; ++q) C[3 * r + c] += A[3 * r + q] * B[3 * q + c];
+  return C;
+}
+function inverseTranspose(A) {
+  const cof = [A[4] * A[8] - A[5] * A[7], A[5] * A[6] - A[3] * A[8], A[3] * A[7] - A[4] * A[6],
+    A[2] * A[7] - A[1] * A[8], A[0] * A[8] - A[2] * A[6], A[1] * A[6] - A[0] * A[7],
+    A[1] * A[5] - A[2] * A[4], A[2] * A[3] - A[0] * A[5], A[0] * A[4] - A[1] * A[3]];
+  const det = A[0] * cof[0] + A[1] * cof[1] + A[2] * cof[2];
+  return cof.map((c) => c / det); // the cofactor matrix over det is A⁻ᵀ
+}
+
 /// Step 1: the basis rows times C = [I; M_0ᵀ; t_0ᵀ; ...], and the handles' own vertices moved
 /// rigidly with their maps.
 function blend(k, transforms) {
-  const { columns, basis, freeLocal, rows, xn: x, rest, coefficients: C } = k;
+  const { columns, basis, freeLocal, rows, xn: x, coefficients: C } = k;
   C.fill(0);
   C[0] = C[4] = C[8] = 1;
   for (let j = 0; j < k.handles; ++j) {
@@ -90,6 +215,12 @@ function blend(k, transforms) {
     const v = 6 * freeLocal[i];
     x[v] = px; x[v + 1] = py; x[v + 2] = pz;
   }
+  moveHandles(k, transforms);
+}
+
+/// The handles' own vertices, moved with their maps.
+function moveHandles(k, transforms) {
+  const { xn: x, rest } = k;
   for (let j = 0; j < k.handles; ++j) {
     const t = transforms[j] ?? IDENTITY;
     for (let i = k.handleBegin[j]; i < k.handleBegin[j + 1]; ++i) {

@@ -172,7 +172,8 @@ HttpResponse transform(Session& session, const HttpRequest& request, const ApiLi
 
 /// The region's linear frame (FrameExport) in one buffer of 4-byte little-endian words: a
 /// header of 16 Uint32 (version 1, handles, local vertices, basis rows, basis columns, handle
-/// vertices, faces, normal vertices, ring length, records, residuals, offsets 0 or 1, 0...),
+/// vertices, faces, normal vertices, ring length, records, residuals, offsets 0 or 1, blended
+/// motions 0 or 1, 0...),
 /// then rest, free_local, basis, handle_begin, handle_local, faces, normal_vertices, ring_begin,
 /// ring, record_face, record_slot, record_bary, record_offset, record_residual, residuals,
 /// offsets (docs/server.md).
@@ -190,7 +191,8 @@ HttpResponse kernel_response(const FrameExport& f) {
                                     count(f.ring),
                                     count(f.record_face),
                                     count(f.residuals) / 3,
-                                    f.offsets.empty() ? 0u : 1u};
+                                    f.offsets.empty() ? 0u : 1u,
+                                    f.blended ? 1u : 0u};
   HttpResponse r;
   r.content_type = "application/octet-stream";
   const auto append = [&r](const void* data, std::size_t bytes) {

@@ -588,9 +588,12 @@ FrameExport Session::frame_export() const {
   std::lock_guard lock(impl_->mutex);
   const Impl& m = *impl_;
   m.require_region();
-  if (m.box->editor.options().method != EditMethod::Linear)
-    throw Busy("the region's method is nonlinear: its frames are computed here, not in the "
-               "page (the kernel is served for method linear)");
+  const EditorOptions& o = m.box->editor.options();
+  if (o.method != EditMethod::Linear && o.nonlinear.energy != NonlinearEnergy::BlendedMotions)
+    throw Busy(fmt::format("the region's method is nonlinear with the energy {}: its frames "
+                           "iterate here (the kernel is served for method linear and the energy "
+                           "blended-motions)",
+                           to_string(o.nonlinear.energy)));
   return remora::frame_export(m.box->editor);
 }
 

@@ -17,7 +17,7 @@
 import { join } from 'node:path';
 import { args, check, chromiumOrSkip, client, drag, ready, recordRequests, results, startServer, stroke,
          writeBumpyTorus } from './harness.mjs';
-import { brokenUpload, bugChecks, creases, displayOptions, largeFaceColours } from './e2e_rules.mjs';
+import { brokenUpload, bugChecks, creases, displayOptions, kernelAgrees, largeFaceColours } from './e2e_rules.mjs';
 
 const large = args.large ? Number(args.large) : 0;
 // Where to paint: the bunny's left ear, or the top of the torus (seen from +z).
@@ -76,29 +76,6 @@ async function dragArrow(page) {
   return pivot1.map((x, i) => x - pivot0[i]);
 }
 
-/// The page's own frame (web/kernel.js, single-precision data) against the server's under a map
-/// that rotates by 40 degrees about z through the handle's centre and scales anisotropically:
-/// every coordinate within 1e-5 of the mesh's bounding diagonal. Then back to the map `dragged`.
-async function kernelAgrees(page, rest, region, dragged) {
-  const lo = [Infinity, Infinity, Infinity], hi = [-Infinity, -Infinity, -Infinity], c = [0, 0, 0];
-  for (let i = 0; i < rest.length; ++i) { lo[i % 3] = Math.min(lo[i % 3], rest[i]); hi[i % 3] = Math.max(hi[i % 3], rest[i]); }
-  const diagonal = Math.hypot(...hi.map((h, i) => h - lo[i]));
-  for (const v of region.handles[0]) for (let k = 0; k < 3; ++k) c[k] += rest[3 * v + k] / region.handles[0].length;
-  const a = (40 * Math.PI) / 180, cs = Math.cos(a), sn = Math.sin(a);
-  const M = [[1.2 * cs, -sn, 0], [1.2 * sn, cs, 0], [0, 0, 0.9]];
-  const rows = [];
-  for (let r = 0; r < 3; ++r) rows.push(...M[r], c[r] - M[r][0] * c[0] - M[r][1] * c[1] - M[r][2] * c[2] + dragged[4 * r + 3]);
-  const local = await page.evaluate((t) => window.remora.kernelFrame([t]), rows);
-  const post = (matrix) => api('transform', { method: 'POST', headers: { 'Content-Type': 'application/json' },
-                                              body: JSON.stringify({ handle: 0, matrix }) });
-  const server = new Float32Array(await (await post(rows)).arrayBuffer());
-  let worst = local && local.length === server.length ? 0 : Infinity;
-  for (let i = 0; i < server.length && worst < Infinity; ++i) worst = Math.max(worst, Math.abs(local[i] - server[i]));
-  check(worst <= 1e-5 * diagonal, `the page's frame equals the server's under a rotation and a scaling ` +
-        `(${server.length / 3} vertices, off by ${worst.toExponential(2)}, bound ${(1e-5 * diagonal).toExponential(2)})`);
-  await post(dragged);
-}
-
 /// The core: paint, drag, the handle moved by the drag and nothing outside the support, the
 /// page's normals, no mesh download after a stroke, undo exact.
 async function core(page, log) {
@@ -153,7 +130,7 @@ async function core(page, log) {
     return worst;
   }, Array.from(after));
   check(pageOff < 1e-6, `after the drag the page holds the server's positions (off by ${pageOff})`);
-  await kernelAgrees(page, before, region, t);
+  await kernelAgrees(page, { api, floats, json }, before, region, t);
   const normalError = await page.evaluate(() => window.remora.normalError?.() ?? Infinity);
   check(normalError < 1e-5, `after the drag the page's normals equal a full computeVertexNormals() (off by ${normalError.toExponential(2)})`);
   await shot(page, large ? 'editor-large-dragged.png' : 'editor-dragged.png');
@@ -179,7 +156,7 @@ async function core(page, log) {
         `is the input within ${roundOff.toExponential(1)})`);
   await page.click('#redo');
   await ready(page);
-  return { region, translation };
+  return { region, translation, rest: before };
 }
 
 let page;

@@ -164,6 +164,7 @@ async function methodAfterMove(page, c, edit) {
         sb.nonlinear?.converged === true && sb.nonlinear?.iterations === 0 &&
         await pageVsServer(page) === 0,
         `blended motions keep the transforms, converge at once, the page shows them (${JSON.stringify(sb.region)})`);
+  await kernelAgrees(page, c, edit.rest, edit.region, sb.transforms[0], 'with blended motions the page\'s frame');
   await page.selectOption('#method', 'linear');
   await ready(page);
   const s3 = await c.json('status');
@@ -308,6 +309,34 @@ async function regionInPause(page, log, c, site) {
   check(before >= 1 && after === before && await activeTool(page) === 'orbit' &&
         (await remora(page, 'shown')).manipulator,
         `a pause then mouse-up sends nothing more (${before} then ${after}) and shows the manipulator`);
+}
+
+/// The page's own frame (web/kernel.js, single-precision data) against the server's under a map
+/// that rotates by 40 degrees about z through the handle's centre and scales anisotropically:
+/// every coordinate within 1e-5 of the mesh's bounding diagonal. Then back to the map `dragged`
+/// (12 numbers). `rest`: the positions at rest; c: the API client.
+export async function kernelAgrees(page, c, rest, region, dragged, what = 'the page\'s frame') {
+  const lo = [Infinity, Infinity, Infinity], hi = [-Infinity, -Infinity, -Infinity], o = [0, 0, 0];
+  for (let i = 0; i < rest.length; ++i) { lo[i % 3] = Math.min(lo[i % 3], rest[i]); hi[i % 3] = Math.max(hi[i % 3], rest[i]); }
+  const diagonal = Math.hypot(...hi.map((h, i) => h - lo[i]));
+  for (const v of region.handles[0]) for (let k = 0; k < 3; ++k) o[k] += rest[3 * v + k] / region.handles[0].length;
+  const a = (40 * Math.PI) / 180, cs = Math.cos(a), sn = Math.sin(a);
+  const M = [[1.2 * cs, -sn, 0], [1.2 * sn, cs, 0], [0, 0, 0.9]];
+  const rows = [];
+  for (let r = 0; r < 3; ++r) rows.push(...M[r], o[r] - M[r][0] * o[0] - M[r][1] * o[1] - M[r][2] * o[2] + dragged[4 * r + 3]);
+  let local = null;
+  for (const end = Date.now() + 60000; !local && Date.now() < end;) {
+    local = await page.evaluate((t) => window.remora.kernelFrame([t]), rows);
+    if (!local) await page.waitForTimeout(200);
+  }
+  const post = (matrix) => c.api('transform', { method: 'POST', headers: { 'Content-Type': 'application/json' },
+                                              body: JSON.stringify({ handle: 0, matrix }) });
+  const server = new Float32Array(await (await post(rows)).arrayBuffer());
+  let worst = local && local.length === server.length ? 0 : Infinity;
+  for (let i = 0; i < server.length && worst < Infinity; ++i) worst = Math.max(worst, Math.abs(local[i] - server[i]));
+  check(worst <= 1e-5 * diagonal, `${what} equals the server's under a rotation and a scaling ` +
+        `(${server.length / 3} vertices, off by ${worst.toExponential(2)}, bound ${(1e-5 * diagonal).toExponential(2)})`);
+  await post(dragged);
 }
 
 export const bugChecks = {

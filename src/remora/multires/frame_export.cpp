@@ -41,14 +41,17 @@ std::vector<std::uint32_t> as_unsigned(const std::vector<int>& v) {
 FrameExport frame_export(const Editor& editor) {
   const Editor::Impl& m = *editor.impl_;
   if (!m.region) throw InvalidArgument("no region yet: call set_region() first");
-  if (m.options.method != EditMethod::Linear)
-    throw InvalidArgument("the frame is exported for method linear only: the nonlinear method's "
-                          "frames iterate on the server");
+  const bool blended = m.options.method == EditMethod::Nonlinear &&
+                       m.options.nonlinear.energy == NonlinearEnergy::BlendedMotions;
+  if (m.options.method != EditMethod::Linear && !blended)
+    throw InvalidArgument("the frame is exported for method linear and the nonlinear energy "
+                          "blended-motions only: the other energies' frames iterate");
   const RegionState& r = *m.region;
   const NormalPlan& plan = r.affected;
   const FrameDetails& details = r.details;
   FrameExport out;
   out.handles = r.handles;
+  out.blended = blended;
 
   // Faces: the normals' faces first (ring indexes them as they are), then the decode's.
   LocalIds face_ids(m.topology.faces.size()),

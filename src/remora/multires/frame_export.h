@@ -6,7 +6,10 @@
 // A client's frame, for transforms T_j = [M_j | t_j] (j < handles), with C the (3 + 4h) × 3
 // matrix [I; M_0ᵀ; t_0ᵀ; ...] of editor.h:
 //  1. x = rest positions; x[free_local[i]] = basis row i · C; x[v] = M_j rest[v] + t_j for the
-//     vertices of handle j (handle_local[handle_begin[j] .. handle_begin[j + 1])).
+//     vertices of handle j (handle_local[handle_begin[j] .. handle_begin[j + 1])). With
+//     `blended` (method nonlinear, energy blended-motions) the free rows are instead the blend
+//     of motion_blend.h, the weights w_j being the basis rows' columns 3 + 4j + 3 and the pivots
+//     o_j the centroids of the handles' rest positions.
 //  2. n = rest normals; for normal_vertices[i]: the normalized sum over its faces
 //     ring[ring_begin[i] .. ring_begin[i + 1]) of (x1 − x0) × (x2 − x0), (0, 0, 0) where it
 //     vanishes.
@@ -24,6 +27,7 @@ class Editor;
 
 struct FrameExport {
   int handles = 0;
+  bool blended = false; ///< step 1 blends the handles' motions (motion_blend.h)
   /// n_local × 6: B0's position and unit normal (that of normal_vertices is step 2's to compute)
   std::vector<float> rest;
   std::vector<std::uint32_t> free_local;   ///< per basis row, its local vertex
@@ -41,7 +45,8 @@ struct FrameExport {
 };
 
 /// The editor's current region as a FrameExport. Throws InvalidArgument without a region or
-/// when the editor's method is not linear (the nonlinear frames are the server's).
+/// when the editor's method is nonlinear with another energy than blended-motions (whose frames
+/// iterate: they are the server's).
 FrameExport frame_export(const Editor& editor);
 
 } // namespace remora
