@@ -102,7 +102,7 @@ function blendMotions(k, transforms) {
         yz += w * (S[6] * dx + S[7] * dy + (S[8] - 1) * dz);
       }
     }
-    screwApply([wx, wy, wz], [ux, uy, uz], [yx, yy, yz], x, v);
+    screwApply(wx, wy, wz, ux, uy, uz, yx, yy, yz, x, v);
   }
   moveHandles(k, transforms);
 }
@@ -127,19 +127,25 @@ function handleMotion(t, pivot) {
   return { omega, v, stretch: S, pivot, stretched };
 }
 
-/// exp(twist (w, v)) applied to y, into x[at .. at + 2] (screw_apply()).
-function screwApply(w, v, y, x, at) {
-  const theta = Math.hypot(w[0], w[1], w[2]);
+/// exp(twist (w, v)) applied to y, into x[at .. at + 2] (screw_apply()): y + s w×y + a w×(w×y)
+/// + v + a w×v + b w×(w×v). Scalars only: it runs once per vertex.
+function screwApply(w0, w1, w2, v0, v1, v2, y0, y1, y2, x, at) {
+  const t2 = w0 * w0 + w1 * w1 + w2 * w2, theta = Math.sqrt(t2);
   let a, b, s;
   if (theta < 1e-4) {
-    const t2 = theta * theta;
     a = 0.5 - t2 / 24; b = 1 / 6 - t2 / 120; s = 1 - t2 / 6;
   } else {
-    a = (1 - Math.cos(theta)) / (theta * theta); b = (theta - Math.sin(theta)) / (theta * theta * theta);
-    s = Math.sin(theta) / theta;
+    const sin = Math.sin(theta);
+    a = (1 - Math.cos(theta)) / t2; b = (theta - sin) / (t2 * theta); s = sin / theta;
   }
-  const wy = cross(w, y), wwy = cross(w, wy), wv = cross(w, v), wwv = cross(w, wv);
-  for (let c = 0; c < 3; ++c) x[at + c] = y[c] + s * wy[c] + a * wwy[c] + v[c] + a * wv[c] + b * wwv[c];
+  // p = w×y, q = w×p, r = w×v, u = w×r.
+  const p0 = w1 * y2 - w2 * y1, p1 = w2 * y0 - w0 * y2, p2 = w0 * y1 - w1 * y0;
+  const q0 = w1 * p2 - w2 * p1, q1 = w2 * p0 - w0 * p2, q2 = w0 * p1 - w1 * p0;
+  const r0 = w1 * v2 - w2 * v1, r1 = w2 * v0 - w0 * v2, r2 = w0 * v1 - w1 * v0;
+  const u0 = w1 * r2 - w2 * r1, u1 = w2 * r0 - w0 * r2, u2 = w0 * r1 - w1 * r0;
+  x[at] = y0 + s * p0 + a * q0 + v0 + a * r0 + b * u0;
+  x[at + 1] = y1 + s * p1 + a * q1 + v1 + a * r1 + b * u1;
+  x[at + 2] = y2 + s * p2 + a * q2 + v2 + a * r2 + b * u2;
 }
 
 /// The rotation of the polar decomposition of M (3×3 row-major, det M > 0): Higham's iteration

@@ -13,7 +13,8 @@
 //                        frame (X-Frame-Ms), drag_round_trip_ms, the request's send to its answer
 //                        read, drag_apply_ms, the positions and normals applied in the page;
 //   bake_ms              a new stroke after a move (the edited shape baked, a new region) until paintable;
-//                        With method linear the page evaluates the frames itself (web/kernel.js):
+//                        With method linear and blended motions the page evaluates the frames itself
+//                        (web/kernel.js):
 //                        drag_kernel_ms is that evaluation, and there is no server part or round trip
 //                        (--server-frames: the server's frames instead); kernel_bytes, the region's
 //                        kernel, and kernel_after_mouseup_ms, its arrival after the handle stroke's
@@ -98,8 +99,9 @@ try {
     const [ms, bytes, server, trip, apply, kernel] = keys.map((k) => mm[k].slice(before[k].length));
     return { ms, bytes, server, trip, apply, kernel };
   };
-  // Method linear: the page evaluates the drag's frames once the region's kernel is here.
-  if (!serverFrames && (args.method ?? 'linear') === 'linear')
+  // Method linear and blended motions: the page evaluates the drag's frames once the region's
+  // kernel is here.
+  if (!serverFrames && ['linear', 'blended-motions'].includes(args.method ?? 'linear'))
     await page.waitForFunction(() => window.remora.kernelFrame([]) !== null, null, { timeout: 120000 }).catch(() => {});
   const afterKernel = await marks();
   const kernelMark = afterKernel.kernel.at(-1);
