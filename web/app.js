@@ -119,9 +119,9 @@ async function fetchRegion(s, labelsKnown) {
 }
 
 // ---- the frames of method linear and of blended motions in the page (kernel.js) ------------------
-// A drag under method linear or the energy blended-motions is evaluated here, from the region's kernel fetched once after the
-// region is ready; the server is sent every map (without an answer) and answers the last one of
-// the drag, whose positions the page then shows. Until the kernel is here, and for the nonlinear
+// A drag under method linear or the energy blended-motions is evaluated here, from the region's
+// kernel fetched once after the region is ready; the server is sent every map (without an
+// answer) and answers the last one of the drag, whose positions the page then shows. Until the kernel is here, and for the nonlinear
 // energies that iterate, the server's answers are the frames.
 let kernel = null; // { regionId, data, out }
 function loadKernel(s) {

@@ -170,11 +170,10 @@ HttpResponse transform(Session& session, const HttpRequest& request, const ApiLi
   return r;
 }
 
-/// The region's linear frame (FrameExport) in one buffer of 4-byte little-endian words: a
-/// header of 16 Uint32 (version 1, handles, local vertices, basis rows, basis columns, handle
-/// vertices, faces, normal vertices, ring length, records, residuals, offsets 0 or 1, blended
-/// motions 0 or 1, 0...),
-/// then rest, free_local, basis, handle_begin, handle_local, faces, normal_vertices, ring_begin,
+/// The region's frame (FrameExport) in one buffer of 4-byte little-endian words: a header of 16
+/// Uint32 (version 1, handles, local vertices, basis rows, basis columns, handle vertices, faces,
+/// normal vertices, ring length, records, residuals, offsets 0 or 1, blended motions 0 or 1,
+/// 0...), then rest, free_local, basis, handle_begin, handle_local, faces, normal_vertices, ring_begin,
 /// ring, record_face, record_slot, record_bary, record_offset, record_residual, residuals,
 /// offsets (docs/server.md).
 HttpResponse kernel_response(const FrameExport& f) {

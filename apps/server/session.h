@@ -123,9 +123,9 @@ public:
   std::vector<std::uint32_t> indices() const;
   /// The vertices that can move under the current region (sorted), as ids.
   std::vector<std::uint32_t> movable_vertices() const;
-  /// The current region's linear frame as data (multires/frame_export.h), for a page that
-  /// evaluates the frames of a drag itself. Throws Busy without a region or while a job runs, and
-  /// when the region's method is nonlinear.
+  /// The current region's frame as data (multires/frame_export.h), for a page that evaluates the
+  /// frames of a drag itself. Throws Busy without a region or while a job runs, and when the
+  /// region's method is nonlinear with an energy that iterates (all but blended-motions).
   FrameExport frame_export() const;
   /// The base surface (remeshed) under the current transforms, its faces, and its vertex areas
   /// over their mean (the "coloured by vertex area" view).

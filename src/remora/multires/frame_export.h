@@ -1,5 +1,5 @@
 // The current region's frame (frame.h: blend, normals, Phong decode) as data, for a client that
-// evaluates the linear method's frames itself: the browser page does, so that a drag needs no
+// evaluates the frames of method linear and of the energy blended-motions itself: the browser page does, so that a drag needs no
 // round trip (web/kernel.js; docs/server.md, `GET /api/region/kernel`). Single precision, in a
 // local numbering of the base: only the base vertices and faces a frame reads.
 //
