@@ -9,6 +9,7 @@
 #include "remora/common/error.h"
 #include "remora/geometry/geodesic.h"
 #include "remora/geometry/selection.h"
+#include "remora/mesh/io.h"
 #include "remora/mesh/primitives.h"
 
 namespace remora {
@@ -120,6 +121,76 @@ TEST(Geodesic, OneMarcherGivesTheSameBallsAsFreshOnesAndFollowsMovedVertices) {
     two.add_face(corners);
   }
   EXPECT_EQ(geodesic_ball(two, VertexHandle(0), 100.0).size(), other.n_vertices());
+}
+
+/// Sources along a path: from vertex `start`, `steps` times the neighbour farthest along +x.
+std::vector<SurfacePoint> path_along_x(const Mesh& mesh, VertexHandle start, int steps) {
+  std::vector<SurfacePoint> path;
+  VertexHandle v = start;
+  for (int i = 0; i < steps; ++i) {
+    const FaceHandle f = *mesh.vf_range(v).begin();
+    const auto corners = face_vertices(mesh, f);
+    std::array<double, 3> bary{0, 0, 0};
+    for (std::size_t k = 0; k < 3; ++k) bary[k] = corners[k] == v ? 1.0 : 0.0;
+    path.push_back({f, bary});
+    for (const VertexHandle w : mesh.vv_range(v))
+      if (mesh.point(w)[0] > mesh.point(v)[0]) v = w;
+  }
+  return path;
+}
+
+/// A stroke along `path` reports what the union of the full balls holds, each vertex once, at no
+/// less than its distance in the full ball of that source.
+void expect_stroke_is_the_union_of_balls(const Mesh& mesh, const std::vector<SurfacePoint>& path,
+                                         double radius) {
+  FastMarching stroke(mesh), full(mesh);
+  std::vector<int> reported, covered;
+  std::vector<char> in_union(mesh.n_vertices(), 0);
+  for (const SurfacePoint& at : path) {
+    std::vector<double> exact(mesh.n_vertices(), -1.0);
+    for (const auto& [v, d] : full.ball(mesh, at, radius)) {
+      exact[static_cast<std::size_t>(v)] = d;
+      if (!in_union[static_cast<std::size_t>(v)]) covered.push_back(v);
+      in_union[static_cast<std::size_t>(v)] = 1;
+    }
+    for (const auto& [v, d] : stroke.stroke_ball(mesh, at, radius)) {
+      reported.push_back(v);
+      ASSERT_GE(exact[static_cast<std::size_t>(v)], 0.0) << "vertex " << v << " is not in the ball";
+      EXPECT_GE(d, exact[static_cast<std::size_t>(v)] - 1e-12);
+    }
+    // Up to this source, the stroke reported exactly the union (each vertex once).
+    auto a = reported, b = covered;
+    std::sort(a.begin(), a.end());
+    std::sort(b.begin(), b.end());
+    ASSERT_EQ(a, b);
+  }
+}
+
+TEST(Geodesic, AStrokeReportsTheUnionOfItsBallsEachVertexOnce) {
+  const Mesh grid = make_grid(80, 80, 1.0, 1.0);
+  expect_stroke_is_the_union_of_balls(grid, path_along_x(grid, VertexHandle(40 * 81 + 10), 30),
+                                      0.2);
+  const Mesh sphere = make_icosphere(5, 1.0);
+  expect_stroke_is_the_union_of_balls(sphere, path_along_x(sphere, VertexHandle(7), 25), 0.5);
+  // A scan's irregular triangles, with a radius of a few edges and of many.
+  const Mesh bunny = read_mesh(std::string(REMORA_REPO_DATA) + "/bunny.ply").mesh;
+  for (const double r : {0.01, 0.03})
+    expect_stroke_is_the_union_of_balls(bunny, path_along_x(bunny, VertexHandle(1000), 30), r);
+}
+
+TEST(Geodesic, AStrokeStartsAgainWithAnotherRadiusOrOnRequest) {
+  const Mesh grid = make_grid(40, 40, 1.0, 1.0);
+  FastMarching marching(grid);
+  const SurfacePoint at{FaceHandle(800), {0.2, 0.3, 0.5}};
+  const std::size_t whole = marching.ball(grid, at, 0.2).size();
+  EXPECT_EQ(marching.stroke_ball(grid, at, 0.2).size(), whole); // ball() ended the stroke
+  EXPECT_TRUE(marching.stroke_ball(grid, at, 0.2).empty());     // nothing new where it was
+  EXPECT_GT(marching.stroke_ball(grid, at, 0.3).size(), whole); // another radius: a new stroke
+  marching.start_stroke();
+  EXPECT_EQ(marching.stroke_ball(grid, at, 0.2).size(), whole);
+  EXPECT_THROW(marching.stroke_ball(grid, at, -1.0), InvalidArgument);
+  EXPECT_THROW(marching.stroke_ball(grid, SurfacePoint{FaceHandle(-1), {1, 0, 0}}, 0.2),
+               InvalidArgument);
 }
 
 TEST(Geodesic, RefusesBadArguments) {

@@ -330,6 +330,52 @@ TEST(ServerEditing, PicksAndBrushesAreTheLibrarysOnTheShapeShown) {
   EXPECT_EQ(brush_of(sphere), within);
 }
 
+TEST(ServerEditing, APicksStrokeAnswersOnlyWhatItsEarlierPicksDidNot) {
+  Session s;
+  load_sphere_with_region(s);
+  const Vec3 down(0, 0, -1);
+  const auto pick = [&](double x, const char* brush, int stroke) {
+    json body{
+        {"origin", {x, 0.1, 3}}, {"direction", {0, 0, -1}}, {"radius", 0.3}, {"brush", brush}};
+    if (stroke >= 0) body["stroke"] = stroke;
+    const HttpResponse r = call(s, "POST", "/api/pick", body.dump());
+    EXPECT_EQ(r.status, 200) << r.body;
+    return brush_of(r);
+  };
+  for (const char* brush : {"geodesic", "sphere"}) {
+    // Along a path: each answer of the stroke is new, and together they are the union of the
+    // whole brushes.
+    std::vector<std::uint32_t> stroke, whole;
+    for (int i = 0; i < 8; ++i)
+      for (const std::uint32_t v : pick(-0.4 + 0.1 * i, brush, -1)) whole.push_back(v);
+    for (int i = 0; i < 8; ++i)
+      for (const std::uint32_t v : pick(-0.4 + 0.1 * i, brush, 7)) stroke.push_back(v);
+    std::sort(whole.begin(), whole.end());
+    whole.erase(std::unique(whole.begin(), whole.end()), whole.end());
+    const std::size_t answered = stroke.size();
+    std::sort(stroke.begin(), stroke.end());
+    EXPECT_EQ(std::unique(stroke.begin(), stroke.end()) - stroke.begin(),
+              static_cast<std::ptrdiff_t>(answered))
+        << brush << ": a vertex answered twice";
+    EXPECT_EQ(stroke, whole) << brush;
+  }
+  // The same point again: nothing new in the stroke; a new stroke, a pick outside a stroke or a
+  // move of the shape starts over.
+  const auto first = pick(0.0, "geodesic", 8);
+  EXPECT_FALSE(first.empty());
+  EXPECT_TRUE(pick(0.0, "geodesic", 8).empty());
+  EXPECT_EQ(pick(0.0, "geodesic", 9), first);
+  pick(0.0, "geodesic", -1);
+  EXPECT_EQ(pick(0.0, "geodesic", 9), first);
+  ASSERT_EQ(move(s, {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0.01}).status, 200);
+  EXPECT_FALSE(pick(0.0, "geodesic", 9).empty());
+  for (const char* bad : {"-1", "1.5", "\"x\"", "1e300"})
+    expect_error(
+        call(s, "POST", "/api/pick",
+             std::string(R"({"origin": [0,0,3], "direction": [0,0,-1], "stroke": )") + bad + "}"),
+        400, "stroke");
+}
+
 TEST(ServerEditing, TheCountersChangeOnlyWithWhatTheyCount) {
   Session s;
   const json empty = status_of(s);

@@ -156,8 +156,15 @@ function localFrame(t0) {
 }
 
 // ---- painting: the server picks, the page colours -----------------------------------------------
+// The picks of a stroke carry its number, and the server answers each with only the vertices it
+// has not answered in that stroke (the page keeps what it painted). A new tool or label, or a
+// pick that failed, starts a new number, whose first answer is the whole brush.
 let painting = false, lastHover = null;
-const picks = new Coalescer((q) => { q.sent = performance.now(); return pick(q.ray, q.radius, q.brush); }, onPick);
+const stroke = { number: 0, key: '' };
+const picks = new Coalescer((q) => {
+  q.sent = performance.now();
+  return pick(q.ray, q.radius, q.brush, q.stroke).catch((e) => { stroke.number += 1; throw e; });
+}, onPick);
 
 function onPick(hit, q) {
   lastHover = hit;
@@ -184,8 +191,9 @@ function paint(ids, tool, label) {
 
 function submitPick(event, paintIt) {
   const tool = state.tool, label = tool === 'support' ? FREE : tool === 'handle' ? state.selected : FIXED;
+  if (paintIt && stroke.key !== `${tool} ${label}`) { stroke.number += 1; stroke.key = `${tool} ${label}`; }
   picks.submit({ ray: view.rayAt(event), radius: paintIt ? panels.radius() : 0, brush: panels.brush(),
-                 paint: paintIt, tool, label, t0: performance.now() });
+                 paint: paintIt, tool, label, stroke: paintIt ? stroke.number : undefined, t0: performance.now() });
 }
 
 // In the capture phase, before the orbit controls: a stroke that starts on the mesh paints, one
@@ -196,6 +204,7 @@ view.container.addEventListener('pointerdown', (event) => {
   message('');
   orbit.enabled = false;
   painting = true;
+  stroke.key = '';
   submitPick(event, true);
 }, { capture: true });
 view.renderer.domElement.addEventListener('pointermove', (event) => {

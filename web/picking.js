@@ -3,13 +3,15 @@
 // that point (geodesic distance along the surface, or Euclidean for the "sphere" brush).
 import { api } from './api.js';
 
-/// One pick: ray { origin, direction } (world space), radius >= 0, brush 'geodesic' | 'sphere'.
-/// Returns { ids: Uint32Array (the brush's vertices, empty for radius 0 or a miss), face (-1 on a
-/// miss), point: [x, y, z] | null, vertex (the hit face's nearest corner, -1 on a miss) }.
-export async function pick(ray, radius, brush) {
+/// One pick: ray { origin, direction } (world space), radius >= 0, brush 'geodesic' | 'sphere',
+/// stroke: a number for the picks of one paint stroke (the server then answers only the vertices
+/// its earlier picks did not), or undefined. Returns { ids: Uint32Array (the brush's vertices,
+/// empty for radius 0 or a miss), face (-1 on a miss), point: [x, y, z] | null, vertex (the hit
+/// face's nearest corner, -1 on a miss) }.
+export async function pick(ray, radius, brush, stroke) {
   const response = await api('pick', {
     method: 'POST', headers: { 'Content-Type': 'application/json' },
-    body: JSON.stringify({ origin: ray.origin, direction: ray.direction, radius, brush }),
+    body: JSON.stringify({ origin: ray.origin, direction: ray.direction, radius, brush, stroke }),
   });
   const ids = new Uint32Array(await response.arrayBuffer());
   const face = parseInt(response.headers.get('X-Hit-Face') ?? '-1', 10);

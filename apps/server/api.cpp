@@ -251,7 +251,7 @@ Vec3 vec3(const json& j, const char* key) {
 
 HttpResponse pick(Session& session, const HttpRequest& request, const ApiLimits& limits) {
   const json j = parse_json(request, limits);
-  only_keys(j, {"origin", "direction", "radius", "brush"});
+  only_keys(j, {"origin", "direction", "radius", "brush", "stroke"});
   const Vec3 origin = vec3(j, "origin"), direction = vec3(j, "direction");
   if (!(direction.sqrnorm() > 0.0)) throw BadRequest("direction: must not be zero");
   double radius = 0.0;
@@ -266,7 +266,15 @@ HttpResponse pick(Session& session, const HttpRequest& request, const ApiLimits&
     if (!j.at("brush").is_string()) throw BadRequest("brush: expected \"geodesic\" or \"sphere\"");
     brush = parse_brush(j.at("brush").get<std::string>());
   }
-  const Pick p = session.pick(origin, direction, radius, brush);
+  std::int64_t stroke = -1;
+  if (j.contains("stroke")) {
+    const json& s = j.at("stroke");
+    if (!s.is_number_integer() || s.get<std::int64_t>() < 0 ||
+        s.get<std::int64_t>() > (std::int64_t{1} << 53))
+      throw BadRequest("stroke: expected an integer from 0 to 2^53");
+    stroke = s.get<std::int64_t>();
+  }
+  const Pick p = session.pick(origin, direction, radius, brush, stroke);
   HttpResponse r = binary_response(p.brush);
   r.headers["X-Hit-Face"] = std::to_string(p.face);
   r.headers["X-Hit-Vertex"] = std::to_string(p.vertex);

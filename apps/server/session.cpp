@@ -622,10 +622,11 @@ std::vector<float> Session::base_areas() const {
   return out;
 }
 
-Pick Session::pick(const Vec3& origin, const Vec3& direction, double radius, Brush brush) {
+Pick Session::pick(const Vec3& origin, const Vec3& direction, double radius, Brush brush,
+                   std::int64_t stroke) {
   std::lock_guard lock(impl_->mutex);
   if (!impl_->shape) throw Busy("no mesh is loaded yet: load one first");
-  return impl_->shape->pick(origin, direction, radius, brush);
+  return impl_->shape->pick(origin, direction, radius, brush, stroke);
 }
 
 std::string Session::name() const {

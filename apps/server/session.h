@@ -110,9 +110,11 @@ public:
   /// and when ready the mesh, base, region and transforms (docs/server.md).
   nlohmann::json status() const;
   /// Picks on the shape shown (the current positions, live transforms included) with a brush;
-  /// works while a region job runs. Throws Busy before the first load, InvalidArgument for a bad
-  /// ray or radius.
-  Pick pick(const Vec3& origin, const Vec3& direction, double radius, Brush brush);
+  /// works while a region job runs. With `stroke` >= 0 the brush holds only what earlier picks
+  /// of that stroke did not answer (Shape::pick). Throws Busy before the first load,
+  /// InvalidArgument for a bad ray or radius.
+  Pick pick(const Vec3& origin, const Vec3& direction, double radius, Brush brush,
+            std::int64_t stroke = -1);
   /// The loaded file's name ("" before the first load).
   std::string name() const;
   /// The current region as {"support": [ids], "handles": [[ids], ...], "k": k, "method":

@@ -39,9 +39,23 @@ void Shape::set_positions(const std::vector<int>& ids, const Eigen::MatrixXd& po
   }
 }
 
-Pick Shape::pick(const Vec3& origin, const Vec3& direction, double radius, Brush brush) {
+void Shape::start_stroke(std::int64_t stroke, Brush brush, double radius) {
+  marching_.start_stroke();
+  for (const std::uint32_t v : answered_list_) answered_[v] = 0;
+  answered_list_.clear();
+  stroke_ = stroke;
+  stroke_brush_ = brush;
+  stroke_radius_ = radius;
+}
+
+Pick Shape::pick(const Vec3& origin, const Vec3& direction, double radius, Brush brush,
+                 std::int64_t stroke) {
   if (!(radius >= 0.0) || !std::isfinite(radius))
     throw InvalidArgument(fmt::format("radius: {} must be finite and >= 0", radius));
+  // A stroke goes on only on the same shape, with the same brush.
+  if (stroke < 0 || stroke != stroke_ || brush != stroke_brush_ || radius != stroke_radius_ ||
+      stale_ || !moved_.empty())
+    start_stroke(stroke, brush, radius);
   if (stale_)
     caster_.refit(mesh_);
   else if (!moved_.empty())
@@ -67,11 +81,16 @@ Pick Shape::pick(const Vec3& origin, const Vec3& direction, double radius, Brush
   }
   if (radius <= 0.0) return out;
   if (brush == Brush::Sphere) {
-    for (const int v : select_sphere(mesh_, out.point, radius))
-      out.brush.push_back(static_cast<std::uint32_t>(v));
+    if (answered_.size() != mesh_.n_vertices()) answered_.assign(mesh_.n_vertices(), 0);
+    for (const int v : select_sphere(mesh_, out.point, radius)) {
+      const auto u = static_cast<std::uint32_t>(v);
+      if (answered_[u]) continue;
+      out.brush.push_back(u);
+      if (stroke >= 0) answered_[u] = 1, answered_list_.push_back(u);
+    }
     return out;
   }
-  for (const auto& [v, d] : marching_.ball(mesh_, at, radius))
+  for (const auto& [v, d] : marching_.stroke_ball(mesh_, at, radius))
     out.brush.push_back(static_cast<std::uint32_t>(v));
   std::sort(out.brush.begin(), out.brush.end());
   return out;

@@ -40,9 +40,13 @@ public:
   void set_positions(const std::vector<int>& ids, const Eigen::MatrixXd& positions);
 
   /// The first face met by origin + t direction (t > 0) and the brush of `radius` around it.
-  /// The ray caster is refitted first when the positions changed. Throws InvalidArgument for a
-  /// non-finite or zero ray or a negative or non-finite radius.
-  Pick pick(const Vec3& origin, const Vec3& direction, double radius, Brush brush);
+  /// The ray caster is refitted first when the positions changed. With `stroke` >= 0, the brush
+  /// holds only the vertices that no earlier pick of the same stroke (same number, brush and
+  /// radius, no other pick and no move of the shape in between) answered; otherwise every vertex
+  /// of the brush.
+  /// Throws InvalidArgument for a non-finite or zero ray or a negative or non-finite radius.
+  Pick pick(const Vec3& origin, const Vec3& direction, double radius, Brush brush,
+            std::int64_t stroke = -1);
 
   const Mesh& mesh() const { return mesh_; }
 
@@ -53,6 +57,14 @@ private:
   std::vector<int> moved_; // else these did (each once)
   std::vector<char> moved_flag_;
   FastMarching marching_;
+  // The stroke being painted: its number (-1: none), brush and radius, and for the sphere brush
+  // the vertices already answered (the geodesic brush's marcher keeps its own).
+  std::int64_t stroke_ = -1;
+  Brush stroke_brush_ = Brush::Geodesic;
+  double stroke_radius_ = -1.0;
+  std::vector<char> answered_;
+  std::vector<std::uint32_t> answered_list_;
+  void start_stroke(std::int64_t stroke, Brush brush, double radius);
 };
 
 } // namespace remora::server

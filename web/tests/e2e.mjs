@@ -17,7 +17,7 @@
 import { join } from 'node:path';
 import { args, check, chromiumOrSkip, client, drag, ready, recordRequests, results, startServer, stroke,
          writeBumpyTorus } from './harness.mjs';
-import { brokenUpload, bugChecks, creases, displayOptions, kernelAgrees, largeFaceColours } from './e2e_rules.mjs';
+import { brokenUpload, bugChecks, creases, displayOptions, kernelAgrees, largeFaceColours, strokePaintsItsBrushes } from './e2e_rules.mjs';
 
 const large = args.large ? Number(args.large) : 0;
 // Where to paint: the bunny's left ear, or the top of the torus (seen from +z).
@@ -45,7 +45,7 @@ async function paintRegion(page, log) {
   await page.click('button[data-tool="support"]');
   await page.evaluate((r) => window.remora.setRadius(r), site.supportRadius);
   site.supportVertex = await near(site.support); // it rides along with later moves
-  await stroke(page, site.supportVertex);
+  await strokePaintsItsBrushes(page, log, { api }, () => stroke(page, site.supportVertex, 12));
   await page.click('button[data-tool="handle"]');
   await page.evaluate((r) => window.remora.setRadius(r), site.handleRadius);
   const handleVertex = await near(site.handle);

@@ -448,3 +448,34 @@ export async function largeFaceColours(page) {
         `a painted corner of a large face colours it only near the corner: ${painted} vertex painted, ` +
         `pixel change near it ${change(0)}, far from it ${change(1)} (of 255)`);
 }
+
+/// A paint stroke's picks carry one stroke number and the server answers each with the vertices
+/// it has not answered in the stroke: what the stroke painted must be what the whole brushes of
+/// its picks hold (asked again without the number), added to what was painted before. `paint`
+/// makes a stroke with the Support tool.
+export async function strokePaintsItsBrushes(page, log, { api }, paint) {
+  const before = await remora(page, 'labels');
+  const from = log.length;
+  await paint();
+  await ready(page);
+  const after = await remora(page, 'labels');
+  const picks = log.slice(from).filter((r) => r.what === 'POST pick' && r.body?.radius > 0);
+  const numbers = new Set(picks.map((r) => r.body.stroke));
+  const union = new Set();
+  let answered = 0;
+  for (const { body } of picks) {
+    const { stroke: _, ...whole } = body;
+    const r = await api('pick', { method: 'POST', headers: { 'Content-Type': 'application/json' }, body: JSON.stringify(whole) });
+    const ids = new Uint32Array(await r.arrayBuffer());
+    answered += ids.length;
+    for (const v of ids) union.add(v);
+  }
+  // The Support tool: a brushed vertex becomes free unless a handle holds it; nothing else changes.
+  let wrong = 0;
+  for (let v = 0; v < after.length; ++v)
+    if (after[v] !== (union.has(v) && before[v] < 0 ? -1 : before[v])) wrong += 1;
+  check(picks.length > 1 && numbers.size === 1 && !numbers.has(undefined) && union.size > 0 && wrong === 0,
+        `a stroke's ${picks.length} picks carried one stroke number (${[...numbers].join(', ')}) and it painted ` +
+        `the union of their whole brushes (${union.size} vertices, ${answered} in the whole answers; ${wrong} wrong)`);
+}
+

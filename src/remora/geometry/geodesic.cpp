@@ -50,7 +50,8 @@ void check_radius(double radius) {
 
 FastMarching::FastMarching(const Mesh& mesh)
     : faces_(mesh.n_faces()), ring_begin_(mesh.n_vertices() + 1, 0),
-      distance_(mesh.n_vertices(), kInf), state_(mesh.n_vertices(), kFar) {
+      distance_(mesh.n_vertices(), kInf), state_(mesh.n_vertices(), kFar),
+      nearest_(mesh.n_vertices(), kInf) {
   for (const FaceHandle f : mesh.faces())
     for (const VertexHandle v : face_vertices(mesh, f)) ++ring_begin_[v.idx() + 1];
   for (std::size_t v = 0; v < mesh.n_vertices(); ++v) ring_begin_[v + 1] += ring_begin_[v];
@@ -76,12 +77,17 @@ FastMarching::march(const Mesh& mesh, const std::vector<std::pair<int, double>>&
     state_[static_cast<std::size_t>(v)] = kFar;
   }
   touched_.clear();
+  const bool first = stroke_touched_.empty(); // the whole ball: measure the slack on it
+  double edge_sum = 0.0;
+  std::size_t edges = 0;
   const Vec3* points = mesh.points();
   using Item = std::pair<double, int>;
   std::priority_queue<Item, std::vector<Item>, std::greater<>> front;
   auto offer = [&](int v, double d) {
     const auto i = static_cast<std::size_t>(v);
-    if (!(d < distance_[i]) || d > radius) return; // beyond the radius it is never accepted
+    // Beyond the radius it is never accepted; where an earlier source of the stroke is nearer
+    // by more than the slack, no vertex beyond it is new.
+    if (!(d < distance_[i]) || d > radius || !(d < nearest_[i] + slack_)) return;
     if (state_[i] == kFar) {
       state_[i] = kTrial;
       touched_.push_back(v);
@@ -97,28 +103,38 @@ FastMarching::march(const Mesh& mesh, const std::vector<std::pair<int, double>>&
     const auto i = static_cast<std::size_t>(v);
     if (state_[i] == kAccepted || d > distance_[i]) continue; // a stale entry
     state_[i] = kAccepted;
-    out.emplace_back(v, d);
+    if (nearest_[i] == kInf) {
+      out.emplace_back(v, d);
+      stroke_touched_.push_back(v);
+    }
+    nearest_[i] = std::min(nearest_[i], d);
     const Vec3& pv = points[i];
-    for (std::uint32_t r = ring_begin_[i]; r < ring_begin_[i + 1]; ++r)
-      for (int side = 0; side < 2; ++side) {
-        const auto x = static_cast<std::size_t>(ring_[r][static_cast<std::size_t>(side)]);
-        const auto y = static_cast<std::size_t>(ring_[r][static_cast<std::size_t>(1 - side)]);
-        if (state_[y] == kAccepted) continue;
-        const double vy = (points[y] - pv).norm();
-        double candidate = d + vy;
-        if (state_[x] == kAccepted)
-          candidate = std::min(candidate,
-                               through_triangle((points[x] - pv).norm(), vy,
-                                                (points[y] - points[x]).norm(), d, distance_[x]));
-        offer(static_cast<int>(y), candidate);
-      }
+    for (std::uint32_t r = ring_begin_[i]; r < ring_begin_[i + 1]; ++r) {
+      const auto p = static_cast<std::size_t>(ring_[r][0]);
+      const auto q = static_cast<std::size_t>(ring_[r][1]);
+      const bool p_done = state_[p] == kAccepted, q_done = state_[q] == kAccepted;
+      if (p_done && q_done) continue;
+      const double vp = (points[p] - pv).norm(), vq = (points[q] - pv).norm();
+      if (first) edge_sum += vp, ++edges;
+      // Each corner not yet accepted: along the edge, or through the triangle from the other.
+      if (!p_done)
+        offer(static_cast<int>(p),
+              q_done ? std::min(d + vp, through_triangle(vq, vp, (points[p] - points[q]).norm(), d,
+                                                         distance_[q]))
+                     : d + vp);
+      if (!q_done)
+        offer(static_cast<int>(q),
+              p_done ? std::min(d + vq, through_triangle(vp, vq, (points[q] - points[p]).norm(), d,
+                                                         distance_[p]))
+                     : d + vq);
+    }
   }
+  if (first && edges > 0) slack_ = 2.0 * edge_sum / static_cast<double>(edges);
   return out;
 }
 
-std::vector<std::pair<int, double>> FastMarching::ball(const Mesh& mesh, const SurfacePoint& source,
-                                                       double radius) {
-  check_radius(radius);
+std::vector<std::pair<int, double>> FastMarching::seeds_of(const Mesh& mesh,
+                                                           const SurfacePoint& source) {
   const FaceHandle f = source.face;
   if (!f.is_valid() || f.idx() >= static_cast<int>(mesh.n_faces()) || mesh.status(f).deleted())
     throw InvalidArgument(
@@ -131,6 +147,30 @@ std::vector<std::pair<int, double>> FastMarching::ball(const Mesh& mesh, const S
   std::vector<std::pair<int, double>> seeds;
   for (const VertexHandle v : face_vertices(mesh, f))
     seeds.emplace_back(v.idx(), (mesh.point(v) - point).norm());
+  return seeds;
+}
+
+void FastMarching::start_stroke() {
+  for (const int v : stroke_touched_) nearest_[static_cast<std::size_t>(v)] = kInf;
+  stroke_touched_.clear();
+  stroke_radius_ = -1.0;
+  slack_ = 0.0;
+}
+
+std::vector<std::pair<int, double>>
+FastMarching::stroke_ball(const Mesh& mesh, const SurfacePoint& source, double radius) {
+  check_radius(radius);
+  const auto seeds = seeds_of(mesh, source);
+  if (radius != stroke_radius_) start_stroke();
+  stroke_radius_ = radius;
+  return march(mesh, seeds, radius);
+}
+
+std::vector<std::pair<int, double>> FastMarching::ball(const Mesh& mesh, const SurfacePoint& source,
+                                                       double radius) {
+  check_radius(radius);
+  const auto seeds = seeds_of(mesh, source);
+  start_stroke();
   return march(mesh, seeds, radius);
 }
 
@@ -142,6 +182,7 @@ std::vector<std::pair<int, double>> FastMarching::ball(const Mesh& mesh, VertexH
     throw InvalidArgument(
         fmt::format("geodesic ball: vertex {} is not a vertex of the mesh (it has {} vertices)",
                     source.idx(), mesh.n_vertices()));
+  start_stroke();
   return march(mesh, {{source.idx(), 0.0}}, radius);
 }
 

@@ -9,6 +9,13 @@
 // distances inconsistent), the distance falls back to the shorter of the two edge paths through
 // the triangle, so the result is never below the straight-line distance of a flat region and never
 // above the edge-path distance. Only the source's connected component is reached.
+//
+// A brush stroke paints the union of balls of one radius along the pointer's path. Marching each
+// ball in full costs the ball's area per pointer move; a stroke (FastMarching::stroke_ball) marches
+// from the new source only where it comes nearer than every earlier source of the stroke (plus a
+// slack of two edge lengths, which the triangle updates need), and reports only the vertices no
+// earlier ball reached: about half the ball's work for a small step, and an answer of the size of
+// the new crescent. The union of what a stroke reports equals the union of the full balls.
 #pragma once
 
 #include <array>
@@ -40,9 +47,20 @@ public:
   /// The same from a vertex (distance 0 there); InvalidArgument for an invalid or deleted vertex.
   std::vector<std::pair<int, double>> ball(const Mesh& mesh, VertexHandle source, double radius);
 
+  /// The next ball of a stroke: the vertices within `radius` of `source` that no earlier ball of
+  /// the stroke reached, with their distance from `source`, in increasing order of distance. The
+  /// first call after start_stroke(), after ball(), or with a radius other than the stroke's
+  /// starts the stroke (and reports the whole ball). The positions must not change within a
+  /// stroke: start a new one when they do. Throws as ball() does.
+  std::vector<std::pair<int, double>> stroke_ball(const Mesh& mesh, const SurfacePoint& source,
+                                                  double radius);
+  /// Forgets the stroke: the next stroke_ball() reports its whole ball.
+  void start_stroke();
+
 private:
   std::vector<std::pair<int, double>>
   march(const Mesh& mesh, const std::vector<std::pair<int, double>>& seeds, double radius);
+  std::vector<std::pair<int, double>> seeds_of(const Mesh& mesh, const SurfacePoint& source);
   std::size_t faces_ = 0;
   std::vector<std::uint32_t> ring_begin_; ///< vertex v's far edges: ring_[ring_begin_[v] ..
   std::vector<std::array<int, 2>>
@@ -50,6 +68,12 @@ private:
   std::vector<double> distance_;    ///< +inf except where the last march wrote
   std::vector<std::uint8_t> state_; ///< far, trial, accepted
   std::vector<int> touched_;        ///< what to reset before the next march
+  // The stroke: the distance from its nearest earlier source of every vertex a ball of it
+  // reached (+inf elsewhere), which marks it reported; the radius, the slack, what to reset.
+  std::vector<double> nearest_;
+  std::vector<int> stroke_touched_;
+  double stroke_radius_ = -1.0; ///< < 0: no stroke
+  double slack_ = 0.0;
 };
 
 /// FastMarching(mesh).ball(mesh, source, radius): one ball.
