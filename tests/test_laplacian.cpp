@@ -147,6 +147,40 @@ TEST(LaplacianWeights, WeightsMatrixOfUnitWeightsIsTheGraphLaplacian) {
   EXPECT_THROW(weights_matrix(mesh, std::vector<double>(3, 1.0)), InvalidArgument);
 }
 
+TEST(LaplacianWeights, WeightsMatrixIsTheEdgeListsTripletsBitForBit) {
+  // weights_matrix() builds its columns in parallel from the vertices' halfedges: the same
+  // matrix, bit for bit, as triplets of every edge (both ways) and the diagonals summed in edge
+  // order.
+  for (const Mesh& mesh :
+       {make_icosphere(5, 1.0), make_grid(70, 40, 2.0, 1.0)}) { // > 1024 vertices: parallel
+    const std::vector<double> w = cotan_edge_weights(mesh);
+    const auto n = static_cast<Eigen::Index>(mesh.n_vertices());
+    Eigen::VectorXd diagonal = Eigen::VectorXd::Zero(n);
+    std::vector<Eigen::Triplet<double>> triplets;
+    for (const EdgeHandle e : mesh.edges()) {
+      const int i = mesh.from_vertex_handle(mesh.halfedge_handle(e, 0)).idx();
+      const int j = mesh.to_vertex_handle(mesh.halfedge_handle(e, 0)).idx();
+      const double x = w[static_cast<std::size_t>(e.idx())];
+      triplets.emplace_back(i, j, x);
+      triplets.emplace_back(j, i, x);
+      diagonal[i] -= x;
+      diagonal[j] -= x;
+    }
+    for (Eigen::Index i = 0; i < n; ++i) triplets.emplace_back(i, i, diagonal[i]);
+    Eigen::SparseMatrix<double> expected(n, n);
+    expected.setFromTriplets(triplets.begin(), triplets.end());
+    const Eigen::SparseMatrix<double> got = weights_matrix(mesh, w);
+    ASSERT_TRUE(got.isCompressed());
+    ASSERT_EQ(got.nonZeros(), expected.nonZeros());
+    for (Eigen::Index k = 0; k <= n; ++k)
+      ASSERT_EQ(got.outerIndexPtr()[k], expected.outerIndexPtr()[k]);
+    for (Eigen::Index k = 0; k < got.nonZeros(); ++k) {
+      ASSERT_EQ(got.innerIndexPtr()[k], expected.innerIndexPtr()[k]);
+      ASSERT_EQ(got.valuePtr()[k], expected.valuePtr()[k]);
+    }
+  }
+}
+
 TEST(LaplacianWeights, SymmetricWithZeroRowSums) {
   for (int which = 0; which < 3; ++which) {
     SCOPED_TRACE(which);

@@ -9,6 +9,7 @@
 #include <Eigen/Core>
 
 #include "remora/common/error.h"
+#include "remora/common/parallel.h"
 #include "remora/geometry/measures.h"
 #include "remora/geometry/per_face.h"
 
@@ -84,28 +85,56 @@ Eigen::SparseMatrix<double> weights_matrix(const Mesh& mesh, const std::vector<d
     throw InvalidArgument("weights_matrix: " + std::to_string(weights.size()) +
                           " edge weights for a mesh with " + std::to_string(mesh.n_edges()) +
                           " edges");
-  const auto n = static_cast<Eigen::Index>(mesh.n_vertices());
-  Eigen::VectorXd diagonal = Eigen::VectorXd::Zero(n);
-  std::vector<bool> has_edge(mesh.n_vertices(), false);
-  std::vector<Eigen::Triplet<double>> triplets;
-  triplets.reserve(2 * mesh.n_edges() + mesh.n_vertices());
+  const std::size_t n = mesh.n_vertices();
+  // The diagonal, summed in edge order.
+  std::vector<double> diagonal(n, 0.0);
+  std::vector<char> has_edge(n, 0);
   for (const EdgeHandle e : mesh.edges()) {
     const HalfedgeHandle h = mesh.halfedge_handle(e, 0);
-    const int i = mesh.from_vertex_handle(h).idx();
-    const int j = mesh.to_vertex_handle(h).idx();
+    const auto i = static_cast<std::size_t>(mesh.from_vertex_handle(h).idx());
+    const auto j = static_cast<std::size_t>(mesh.to_vertex_handle(h).idx());
     const double w = weights[static_cast<std::size_t>(e.idx())];
-    triplets.emplace_back(i, j, w);
-    triplets.emplace_back(j, i, w);
     diagonal[i] -= w;
     diagonal[j] -= w;
-    has_edge[static_cast<std::size_t>(i)] = true;
-    has_edge[static_cast<std::size_t>(j)] = true;
+    has_edge[i] = has_edge[j] = 1;
   }
-  for (Eigen::Index i = 0; i < n; ++i) {
-    if (has_edge[static_cast<std::size_t>(i)]) triplets.emplace_back(i, i, diagonal[i]);
-  }
-  Eigen::SparseMatrix<double> W(n, n);
-  W.setFromTriplets(triplets.begin(), triplets.end());
+  // Column j holds the edges out of j and its diagonal, sorted by row (a halfedge mesh has one
+  // edge per pair of vertices). Built in parallel, column by column, in place.
+  const auto size = static_cast<Eigen::Index>(n);
+  Eigen::SparseMatrix<double> W(size, size);
+  int* outer = W.outerIndexPtr();
+  outer[0] = 0;
+  parallel_for(n, 0, [&](std::size_t j) {
+    const VertexHandle v(static_cast<int>(j));
+    int count = has_edge[j] ? 1 : 0;
+    if (!mesh.status(v).deleted())
+      for (auto h = mesh.cvoh_iter(v); h.is_valid(); ++h)
+        count += mesh.status(mesh.edge_handle(*h)).deleted() ? 0 : 1;
+    outer[j + 1] = count;
+  });
+  for (std::size_t j = 0; j < n; ++j) outer[j + 1] += outer[j];
+  W.resizeNonZeros(outer[n]);
+  int* rows = W.innerIndexPtr();
+  double* values = W.valuePtr();
+  parallel_for(n, 0, [&](std::size_t j) {
+    const VertexHandle v(static_cast<int>(j));
+    thread_local std::vector<std::pair<int, double>> entries;
+    entries.clear();
+    if (has_edge[j]) entries.emplace_back(static_cast<int>(j), diagonal[j]);
+    if (!mesh.status(v).deleted())
+      for (auto h = mesh.cvoh_iter(v); h.is_valid(); ++h) {
+        const EdgeHandle e = mesh.edge_handle(*h);
+        if (!mesh.status(e).deleted())
+          entries.emplace_back(mesh.to_vertex_handle(*h).idx(),
+                               weights[static_cast<std::size_t>(e.idx())]);
+      }
+    std::sort(entries.begin(), entries.end(),
+              [](const auto& a, const auto& b) { return a.first < b.first; });
+    for (std::size_t k = 0; k < entries.size(); ++k) {
+      rows[static_cast<std::size_t>(outer[j]) + k] = entries[k].first;
+      values[static_cast<std::size_t>(outer[j]) + k] = entries[k].second;
+    }
+  });
   return W;
 }
 

@@ -1,6 +1,7 @@
 #include "remora/linalg/kharmonic.h"
 
 #include <algorithm>
+#include <future>
 #include <string>
 
 #include "remora/common/error.h"
@@ -194,9 +195,19 @@ void split_columns(const std::vector<RowBlock>& blocks, std::size_t n, KHarmonic
 
 } // namespace
 
-KHarmonicAssembler::KHarmonicAssembler(const Mesh& mesh, int threads)
-    : minus_w_(-cotan_weights(mesh)), inverse_area_(inverse_mixed_areas(mesh)), threads_(threads) {
+KHarmonicAssembler::KHarmonicAssembler(const Mesh& mesh, int threads) : threads_(threads) {
+  // −W on this thread; the areas, the adjacency and its components on another (each part is
+  // mostly a sequential pass over the mesh); one thread when `threads` is 1.
+  auto rest = std::async(threads == 1 ? std::launch::deferred : std::launch::async,
+                         [&] { areas_and_adjacency(mesh); });
+  minus_w_ = cotan_weights(mesh);
   minus_w_.makeCompressed();
+  minus_w_.coeffs() = -minus_w_.coeffs();
+  rest.get();
+}
+
+void KHarmonicAssembler::areas_and_adjacency(const Mesh& mesh) {
+  inverse_area_ = inverse_mixed_areas(mesh);
   const std::size_t n = mesh.n_vertices();
   offsets_.assign(n + 1, 0);
   for (const VertexHandle v : mesh.vertices()) {
@@ -204,9 +215,25 @@ KHarmonicAssembler::KHarmonicAssembler(const Mesh& mesh, int threads)
     offsets_[static_cast<std::size_t>(v.idx()) + 1] = static_cast<int>(adjacent_.size());
   }
   for (std::size_t v = 0; v < n; ++v) offsets_[v + 1] = std::max(offsets_[v + 1], offsets_[v]);
-  const Components components = connected_components(mesh);
-  component_ = components.vertex_component;
-  components_ = components.count;
+  // The connected components of the adjacency, numbered in the order of their smallest vertex
+  // (as connected_components() numbers them).
+  component_.assign(n, -1);
+  std::vector<int> stack;
+  for (std::size_t seed = 0; seed < n; ++seed) {
+    if (component_[seed] >= 0 || mesh.status(VertexHandle(static_cast<int>(seed))).deleted())
+      continue;
+    component_[seed] = components_;
+    stack.push_back(static_cast<int>(seed));
+    while (!stack.empty()) {
+      const auto v = static_cast<std::size_t>(stack.back());
+      stack.pop_back();
+      for (int a = offsets_[v]; a < offsets_[v + 1]; ++a) {
+        const auto w = static_cast<std::size_t>(adjacent_[static_cast<std::size_t>(a)]);
+        if (component_[w] < 0) component_[w] = components_, stack.push_back(static_cast<int>(w));
+      }
+    }
+    ++components_;
+  }
 }
 
 KHarmonicSystem KHarmonicAssembler::assemble(const Region& region,

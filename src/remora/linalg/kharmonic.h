@@ -97,6 +97,7 @@ public:
   const SparseMatrix& minus_w() const { return minus_w_; }
 
 private:
+  void areas_and_adjacency(const Mesh& mesh); // inverse_area_, offsets_, adjacent_, component_
   void check_handles_and_components(const Region& region) const;
 
   SparseMatrix minus_w_;

@@ -182,8 +182,10 @@ BakeResult bake(Editor& editor, const BakeOptions& options) {
     try {
       const double cpu0 = bake_detail::cpu_ms();
       EditorParts parts = bake_detail::local_parts(editor, positions, options, report);
-      report.cpu_milliseconds["total"] = bake_detail::cpu_ms() - cpu0;
+      const auto t_editor = Clock::now();
       Editor baked(std::move(parts), editor.options());
+      report.milliseconds["editor"] = ms_since(t_editor);
+      report.cpu_milliseconds["total"] = bake_detail::cpu_ms() - cpu0;
       report.local = true;
       report.milliseconds["total"] = ms_since(t0);
       return {std::move(baked), std::move(report)};

@@ -60,7 +60,8 @@ struct BakeReport {
   std::size_t reference_faces = 0;         ///< faces of S' under the patch
   std::size_t rewalked_input_vertices = 0; ///< input vertices located on the new base by a walk
   /// Wall time: "filter", "base", "patch" (selection and sub-meshes), "remesh", "stitch",
-  /// "report", "total"; only "total" for the full preprocess.
+  /// "report", "editor" (the new editor's construction: its Laplacian assembler), "total"; only
+  /// "total" for the full preprocess.
   std::map<std::string, double> milliseconds;
   /// The process's CPU time (all threads) in the same parts: on a busy machine the wall time
   /// says little about a part's own work.
