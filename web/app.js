@@ -283,7 +283,7 @@ async function sendRegion({ keepGizmo = false, inStroke = false } = {}) {
   showHandleButtons();
   if (!handles.length || !free) {
     regionSent = null;
-    if (inStroke) return;
+    if (inStroke) { state.dirtyRegion = true; return; } // the mouse-up says what is missing
     if (!handles.length)
       message(support.length ? 'Now paint a handle inside the support (tool "Handle", H).'
                              : 'Paint a support (S), then a handle inside it (H).', 'hint');

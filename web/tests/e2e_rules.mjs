@@ -257,6 +257,14 @@ async function manipulatorRules(page, log) {
         `after New handle the manipulator is hidden (${shown}) and its old place sends no move (${sent}; "${box.hidden ? '' : box.text}")`);
 }
 
+/// Holds the pointer still until the page has sent the region (at most 15 s): 250 ms after the
+/// stroke's last painted answer, which a loaded machine can delay.
+async function regionSentInPause(page, log, from) {
+  await page.waitForTimeout(900);
+  for (const end = Date.now() + 15000; Date.now() < end && since(log, from, /POST region/).length === 0;)
+    await page.waitForTimeout(100);
+}
+
 /// The region's work hides behind the brush: a stroke that pauses sends the region painted so
 /// far; painting on after it sends the region again (the server stops the stale job) and the
 /// server ends with the region as painted at mouse-up; a pause with nothing painted after it
@@ -282,7 +290,7 @@ async function regionInPause(page, log, c, site) {
   await page.mouse.move(start.x, start.y);
   await page.mouse.down();
   for (let i = 1; i <= 4; ++i) await page.mouse.move(start.x + 2 * i, start.y);
-  await page.waitForTimeout(900);
+  await regionSentInPause(page, log, from);
   const inPause = since(log, from, /POST region/).length;
   for (let i = 1; i <= 6; ++i) await page.mouse.move(start.x + 8, start.y + 4 * i);
   await page.mouse.up();
@@ -300,7 +308,7 @@ async function regionInPause(page, log, c, site) {
   await page.mouse.move(start.x - 6, start.y - 6);
   await page.mouse.down();
   for (let i = 1; i <= 3; ++i) await page.mouse.move(start.x - 6 - 2 * i, start.y - 6);
-  await page.waitForTimeout(900);
+  await regionSentInPause(page, log, from);
   await ready(page, 120000).catch(() => {});
   const before = since(log, from, /POST region/).length;
   await page.mouse.up();
