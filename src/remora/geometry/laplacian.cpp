@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -114,6 +115,7 @@ Eigen::SparseMatrix<double> weights_matrix(const Mesh& mesh, const std::vector<d
   });
   for (std::size_t j = 0; j < n; ++j) outer[j + 1] += outer[j];
   W.resizeNonZeros(outer[n]);
+  std::atomic<int> repeated{-1}; // a vertex with two edges to the same neighbour
   int* rows = W.innerIndexPtr();
   double* values = W.valuePtr();
   parallel_for(n, 0, [&](std::size_t j) {
@@ -130,11 +132,16 @@ Eigen::SparseMatrix<double> weights_matrix(const Mesh& mesh, const std::vector<d
       }
     std::sort(entries.begin(), entries.end(),
               [](const auto& a, const auto& b) { return a.first < b.first; });
+    for (std::size_t k = 1; k < entries.size(); ++k)
+      if (entries[k].first == entries[k - 1].first) repeated = static_cast<int>(j);
     for (std::size_t k = 0; k < entries.size(); ++k) {
       rows[static_cast<std::size_t>(outer[j]) + k] = entries[k].first;
       values[static_cast<std::size_t>(outer[j]) + k] = entries[k].second;
     }
   });
+  if (repeated >= 0)
+    throw Error("weights_matrix: vertex " + std::to_string(repeated.load()) +
+                " has two edges to the same neighbour; the mesh's connectivity is corrupt");
   return W;
 }
 

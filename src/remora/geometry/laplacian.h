@@ -38,9 +38,10 @@ double cotan_weight(const Mesh& mesh, EdgeHandle e);
 std::vector<double> cotan_edge_weights(const Mesh& mesh);
 
 /// The symmetric n_vertices() x n_vertices() matrix of any edge weights, assembled like W above:
-/// W_ij = W_ji = weights[e.idx()] for every live edge e = (i, j), W_ii = -sum_j W_ij, with
-/// cotan_weights()'s structure (two edges joining the same vertices are summed). Throws
-/// InvalidArgument unless `weights` has n_edges() entries.
+/// W_ij = W_ji = weights[e.idx()] for every live edge e = (i, j), W_ii = -sum_j W_ij (summed in
+/// edge order), with cotan_weights()'s structure. Throws InvalidArgument unless `weights` has
+/// n_edges() entries, and Error for two edges joining the same two vertices (which a half-edge
+/// mesh built by add_face() does not have).
 Eigen::SparseMatrix<double> weights_matrix(const Mesh& mesh, const std::vector<double>& weights);
 
 /// How far the Laplacian is from its symmetric approximation of paper §5 (every A_i replaced by
