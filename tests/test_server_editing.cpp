@@ -333,7 +333,6 @@ TEST(ServerEditing, PicksAndBrushesAreTheLibrarysOnTheShapeShown) {
 TEST(ServerEditing, APicksStrokeAnswersOnlyWhatItsEarlierPicksDidNot) {
   Session s;
   load_sphere_with_region(s);
-  const Vec3 down(0, 0, -1);
   const auto pick = [&](double x, const char* brush, int stroke) {
     json body{
         {"origin", {x, 0.1, 3}}, {"direction", {0, 0, -1}}, {"radius", 0.3}, {"brush", brush}};
