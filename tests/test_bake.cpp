@@ -181,6 +181,26 @@ TEST(Bake, MatchesAFullPreprocessAndKeepsTheRestBitForBit) {
     EXPECT_EQ(qr.components, ql.components);
     EXPECT_EQ(qr.vertices, ql.vertices);
     EXPECT_TRUE(near(report.base_symmetry_defect, laplacian_symmetry_defect(local.editor.base())));
+    // The Laplacian assembler, carried over from the old editor where the base did not change,
+    // is the new base's: −W to round-off in the diagonal, the same systems.
+    const KHarmonicAssembler fresh(local.editor.base());
+    const SparseMatrix& carried = local.editor.parts().assembler.minus_w();
+    EXPECT_LE((carried - fresh.minus_w()).norm(), 1e-14 * fresh.minus_w().norm());
+    const KHarmonicOptions mixed{2, AreaWeights::MixedSymmetric};
+    const Mesh& nb = local.editor.base();
+    Region labels = Region::all_fixed(nb.n_vertices());
+    const Vec3 at = c.mesh.point(c.seed);
+    double reach0 = 0;
+    for (const int v : r.support)
+      reach0 = std::max(reach0, (c.mesh.point(VertexHandle(v)) - at).norm());
+    for (const VertexHandle v : nb.vertices()) {
+      const double from = (nb.point(v) - at).norm();
+      if (from < reach0)
+        labels.label[static_cast<std::size_t>(v.idx())] = from < 0.3 * reach0 ? 0 : Region::kFree;
+    }
+    const KHarmonicSystem x = local.editor.parts().assembler.assemble(labels, mixed),
+                          y = fresh.assemble(labels, mixed);
+    EXPECT_LE((x.matrix - y.matrix).norm(), 1e-13 * y.matrix.norm());
 
     // Far from the edit (beyond the band, 8 σ, and a few edges more) S and the base are the old
     // ones, bit for bit.

@@ -1,13 +1,16 @@
 // splice() (mesh/splice.h): a set of faces replaced in place by another triangulation of the same
-// border; checked against the same triangles built from scratch.
+// border; checked against the same triangles built from scratch. And the Laplacian assembler
+// carried over a splice (linalg/kharmonic.h) against one built afresh.
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <set>
 #include <vector>
 
 #include <gtest/gtest.h>
 
 #include "remora/common/error.h"
+#include "remora/linalg/kharmonic.h"
 #include "remora/mesh/build.h"
 #include "remora/mesh/primitives.h"
 #include "remora/mesh/splice.h"
@@ -113,36 +116,113 @@ TEST(Splice, TheSameFacesPutBackGiveTheSameMesh) {
   expect_splice(mesh, removed, patch, origin);
 }
 
-// More vertices and faces than removed: splits inside the patch; fewer: collapses, so that the
-// last elements of the mesh move into the places left over.
+// The faces of `mesh` near `center` cut out and changed inside: three splits (`more`) or three
+// collapses, so that the last elements of the mesh move into the places left over when spliced
+// back. `origin` as splice() takes it.
+Mesh changed_patch(const Mesh& mesh, const std::vector<char>& removed, bool more,
+                   std::vector<int>& origin) {
+  Mesh patch = cut_out(mesh, removed, origin);
+  int changes = 0;
+  for (const EdgeHandle e : patch.edges()) {
+    if (changes == 3) break;
+    if (patch.status(e).deleted() || patch.is_boundary(e)) continue;
+    const HalfedgeHandle h = patch.halfedge_handle(e, 0);
+    if (patch.is_boundary(patch.from_vertex_handle(h)) ||
+        patch.is_boundary(patch.to_vertex_handle(h)))
+      continue;
+    if (more) {
+      patch.split(e, patch.calc_edge_midpoint(e));
+      ++changes;
+    } else if (patch.is_collapse_ok(h)) {
+      patch.collapse(h);
+      ++changes;
+    }
+  }
+  EXPECT_EQ(changes, 3);
+  patch.garbage_collection();
+  origin.resize(patch.n_vertices(), -1);
+  for (const VertexHandle v : patch.vertices())
+    if (!patch.is_boundary(v)) origin[static_cast<std::size_t>(v.idx())] = -1;
+  return patch;
+}
+
+// More vertices and faces than removed: splits inside the patch; fewer: collapses.
 TEST(Splice, MoreOrFewerElementsThanRemoved) {
   for (const bool more : {true, false}) {
     Mesh mesh = make_icosphere(3);
     const auto removed = faces_near(mesh, Vec3(1, 0, 0), 0.6);
     std::vector<int> origin;
-    Mesh patch = cut_out(mesh, removed, origin);
-    int changes = 0;
-    for (const EdgeHandle e : patch.edges()) {
-      if (changes == 3) break;
-      if (patch.status(e).deleted() || patch.is_boundary(e)) continue;
-      const HalfedgeHandle h = patch.halfedge_handle(e, 0);
-      if (patch.is_boundary(patch.from_vertex_handle(h)) ||
-          patch.is_boundary(patch.to_vertex_handle(h)))
-        continue;
-      if (more) {
-        patch.split(e, patch.calc_edge_midpoint(e));
-        ++changes;
-      } else if (patch.is_collapse_ok(h)) {
-        patch.collapse(h);
-        ++changes;
+    const Mesh patch = changed_patch(mesh, removed, more, origin);
+    expect_splice(mesh, removed, patch, origin);
+  }
+}
+
+// The Laplacian assembler carried over a splice and moved points (linalg/kharmonic.h) against one
+// built afresh: the same −W (its copied diagonal entries to round-off), and the same systems.
+TEST(Splice, TheAssemblerCarriedOverASpliceMatchesOneBuiltAfresh) {
+  for (const bool more : {true, false}) {
+    Mesh mesh = make_icosphere(4);
+    const KHarmonicAssembler before(mesh);
+    const auto removed = faces_near(mesh, Vec3(1, 0, 0), 0.5);
+    std::vector<int> origin;
+    const Mesh patch = changed_patch(mesh, removed, more, origin);
+    const SpliceMap map = splice(mesh, removed, patch, origin);
+    const std::size_t n = mesh.n_vertices();
+    std::vector<int> previous_of(n, -1);
+    std::vector<char> changed(n, 1);
+    for (std::size_t o = 0; o < map.vertices.size(); ++o)
+      if (map.vertices[o] >= 0) {
+        previous_of[static_cast<std::size_t>(map.vertices[o])] = static_cast<int>(o);
+        changed[static_cast<std::size_t>(map.vertices[o])] = 0;
+      }
+    for (const int v : map.patch_vertices) changed[static_cast<std::size_t>(v)] = 1;
+    // Kept vertices near (0, 1, 0) pushed out: their points change, their faces do not.
+    int moved = 0;
+    for (const VertexHandle v : mesh.vertices())
+      if (!changed[static_cast<std::size_t>(v.idx())] && mesh.point(v)[1] > 0.8) {
+        mesh.set_point(v, mesh.point(v) * 1.1);
+        changed[static_cast<std::size_t>(v.idx())] = 1;
+        ++moved;
+      }
+    ASSERT_GT(moved, 10);
+    const KHarmonicAssembler updated(mesh, before, previous_of, changed), fresh(mesh);
+    const SparseMatrix& a = updated.minus_w();
+    const SparseMatrix& b = fresh.minus_w();
+    ASSERT_EQ(a.nonZeros(), b.nonZeros());
+    for (Eigen::Index c = 0; c < b.outerSize(); ++c) {
+      ASSERT_EQ(a.outerIndexPtr()[c + 1], b.outerIndexPtr()[c + 1]) << "column " << c;
+      for (SparseMatrix::InnerIterator ia(a, c), ib(b, c); ib; ++ia, ++ib) {
+        ASSERT_EQ(ia.row(), ib.row()) << "column " << c;
+        if (ib.row() == c)
+          EXPECT_NEAR(ia.value(), ib.value(), 1e-14 * std::abs(ib.value())) << c;
+        else
+          EXPECT_EQ(ia.value(), ib.value()) << "entry " << ib.row() << ", " << c;
       }
     }
-    ASSERT_EQ(changes, 3);
-    patch.garbage_collection();
-    origin.resize(patch.n_vertices(), -1);
-    for (const VertexHandle v : patch.vertices())
-      if (!patch.is_boundary(v)) origin[static_cast<std::size_t>(v.idx())] = -1;
-    expect_splice(mesh, removed, patch, origin);
+    // The systems use the areas, the one-rings and the components as well.
+    Region region = Region::all_fixed(n);
+    for (const VertexHandle v : mesh.vertices()) {
+      const Vec3& p = mesh.point(v);
+      if (p[0] > 0.97)
+        region.label[static_cast<std::size_t>(v.idx())] = 0;
+      else if (p[0] > 0.0)
+        region.label[static_cast<std::size_t>(v.idx())] = Region::kFree;
+    }
+    for (const AreaWeights areas : {AreaWeights::Mixed, AreaWeights::MixedSymmetric}) {
+      const KHarmonicOptions options{2, areas};
+      const KHarmonicSystem x = updated.assemble(region, options),
+                            y = fresh.assemble(region, options);
+      EXPECT_EQ(x.free_vertices, y.free_vertices);
+      EXPECT_EQ(x.constrained_vertices, y.constrained_vertices);
+      EXPECT_LE((x.matrix - y.matrix).norm(), 1e-13 * y.matrix.norm());
+      EXPECT_LE((x.coupling - y.coupling).norm(), 1e-13 * y.coupling.norm());
+    }
+    // A kept vertex said to be unchanged needs its earlier vertex.
+    std::vector<int> lost = previous_of;
+    const auto kept =
+        static_cast<std::size_t>(std::find(changed.begin(), changed.end(), 0) - changed.begin());
+    lost[kept] = -1;
+    EXPECT_THROW(KHarmonicAssembler(mesh, before, lost, changed), InvalidArgument);
   }
 }
 

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <numbers>
 #include <string>
+#include <vector>
 
 #include "remora/common/error.h"
 
@@ -125,6 +126,23 @@ Eigen::VectorXd vertex_areas_mixed(const Mesh& mesh) {
       areas[v[i].idx()] += parts[static_cast<std::size_t>(f.idx())][static_cast<std::size_t>(i)];
   }
   return areas;
+}
+
+double vertex_area_mixed(const Mesh& mesh, VertexHandle v) {
+  thread_local std::vector<FaceHandle> faces;
+  faces.clear();
+  for (const FaceHandle f : mesh.vf_range(v)) faces.push_back(f);
+  std::sort(faces.begin(), faces.end(),
+            [](FaceHandle x, FaceHandle y) { return x.idx() < y.idx(); });
+  double area = 0.0;
+  for (const FaceHandle f : faces) {
+    const std::array<VertexHandle, 3> c = halfedge_cycle_vertices(mesh, f);
+    const std::array<double, 3> parts =
+        triangle_mixed_areas(mesh.point(c[0]), mesh.point(c[1]), mesh.point(c[2]));
+    for (std::size_t i = 0; i < 3; ++i)
+      if (c[i] == v) area += parts[i];
+  }
+  return area;
 }
 
 BoundingBox bounding_box(const Mesh& mesh) {

@@ -47,6 +47,9 @@ Eigen::VectorXd vertex_areas_barycentric(const Mesh& mesh);
 /// Mixed Voronoi vertex areas: the sum of triangle_mixed_areas() over the incident faces. Both
 /// vertex-area vectors sum to surface_area() to round-off.
 Eigen::VectorXd vertex_areas_mixed(const Mesh& mesh);
+/// The one entry of vertex_areas_mixed() for v: the same sum, bit for bit (its faces in index
+/// order).
+double vertex_area_mixed(const Mesh& mesh, VertexHandle v);
 
 /// Mean length of the mesh's edges (0 for a mesh without edges).
 double mean_edge_length(const Mesh& mesh);

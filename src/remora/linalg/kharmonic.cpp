@@ -33,25 +33,6 @@ void validate_labels(std::size_t n, const Region& region, const KHarmonicOptions
     throw InvalidArgument("k-harmonic system: no vertex is free; the support is empty");
 }
 
-// The inverse vertex areas of the inner factors: 1 / mixed area, floored at 1e-12 times the mean
-// positive area. A vertex whose faces all have zero area (needles of a raw scan) gets a floor
-// instead of an infinite inverse; its row of W is zero anyway.
-Eigen::VectorXd inverse_mixed_areas(const Mesh& mesh) {
-  const auto n = static_cast<Eigen::Index>(mesh.n_vertices());
-  const Eigen::VectorXd area = vertex_areas_mixed(mesh);
-  double mean = 0;
-  Eigen::Index counted = 0;
-  for (Eigen::Index v = 0; v < n; ++v)
-    if (area[v] > 0) {
-      mean += area[v];
-      ++counted;
-    }
-  mean = counted > 0 ? mean / static_cast<double>(counted) : 1.0;
-  Eigen::VectorXd inverse_area(n);
-  for (Eigen::Index v = 0; v < n; ++v) inverse_area[v] = 1.0 / std::max(area[v], 1e-12 * mean);
-  return inverse_area;
-}
-
 // Numbers the free vertices in vertex order: system.free_vertices and system.row_of (-1 for a
 // vertex that is not free).
 void number_free_vertices(const Region& region, KHarmonicSystem& system) {
@@ -207,7 +188,8 @@ KHarmonicAssembler::KHarmonicAssembler(const Mesh& mesh, int threads) : threads_
 }
 
 void KHarmonicAssembler::areas_and_adjacency(const Mesh& mesh) {
-  inverse_area_ = inverse_mixed_areas(mesh);
+  area_ = vertex_areas_mixed(mesh);
+  inverse_areas();
   const std::size_t n = mesh.n_vertices();
   offsets_.assign(n + 1, 0);
   for (const VertexHandle v : mesh.vertices()) {
@@ -215,9 +197,32 @@ void KHarmonicAssembler::areas_and_adjacency(const Mesh& mesh) {
     offsets_[static_cast<std::size_t>(v.idx()) + 1] = static_cast<int>(adjacent_.size());
   }
   for (std::size_t v = 0; v < n; ++v) offsets_[v + 1] = std::max(offsets_[v + 1], offsets_[v]);
-  // The connected components of the adjacency, numbered in the order of their smallest vertex
-  // (as connected_components() numbers them).
+  find_components(mesh);
+}
+
+// The inverse vertex areas of the inner factors: 1 / mixed area, floored at 1e-12 times the mean
+// positive area. A vertex whose faces all have zero area (needles of a raw scan) gets a floor
+// instead of an infinite inverse; its row of W is zero anyway.
+void KHarmonicAssembler::inverse_areas() {
+  const Eigen::Index n = area_.size();
+  double mean = 0;
+  Eigen::Index counted = 0;
+  for (Eigen::Index v = 0; v < n; ++v)
+    if (area_[v] > 0) {
+      mean += area_[v];
+      ++counted;
+    }
+  mean = counted > 0 ? mean / static_cast<double>(counted) : 1.0;
+  inverse_area_.resize(n);
+  for (Eigen::Index v = 0; v < n; ++v) inverse_area_[v] = 1.0 / std::max(area_[v], 1e-12 * mean);
+}
+
+// The connected components of the adjacency, numbered in the order of their smallest vertex (as
+// connected_components() numbers them); -1 for a deleted vertex.
+void KHarmonicAssembler::find_components(const Mesh& mesh) {
+  const std::size_t n = mesh.n_vertices();
   component_.assign(n, -1);
+  components_ = 0;
   std::vector<int> stack;
   for (std::size_t seed = 0; seed < n; ++seed) {
     if (component_[seed] >= 0 || mesh.status(VertexHandle(static_cast<int>(seed))).deleted())

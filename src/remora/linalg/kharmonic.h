@@ -83,6 +83,20 @@ class KHarmonicAssembler {
 public:
   /// Copies what it needs from `mesh` (which may change or go afterwards). `threads`: 0 = all.
   explicit KHarmonicAssembler(const Mesh& mesh, int threads = 0);
+  /// The assembler of `mesh` from `previous`, the assembler of an earlier state of the same
+  /// surface (the editor's local bake, multires/bake.h): `previous_of[v]` is the vertex of the
+  /// earlier mesh that vertex v of `mesh` was (-1: a new vertex), and `changed[v]` is 1 where v is
+  /// new, its point moved, or the faces around it are not the earlier ones (renumbering through
+  /// previous_of aside). The columns of −W, the areas and the one-rings of the vertices with no
+  /// changed vertex on their faces are copied, the others computed, each as the constructor above
+  /// computes it. Equal to KHarmonicAssembler(mesh, threads) but for the order of the sums of a
+  /// copied vertex's diagonal entry and area where the mesh renumbered its edges or faces (round-
+  /// off). The work is the changed part plus linear passes (copies, the components). Throws
+  /// InvalidArgument when the sizes disagree or an unchanged vertex has no earlier vertex; an
+  /// unchanged vertex whose faces did change is not detected (the caller's contract).
+  KHarmonicAssembler(const Mesh& mesh, const KHarmonicAssembler& previous,
+                     const std::vector<int>& previous_of, const std::vector<char>& changed,
+                     int threads = 0);
 
   /// The system of `region` (see the top of this file), its free vertices in vertex order.
   /// Throws InvalidArgument when the label vector does not have one entry per vertex, a label is
@@ -97,10 +111,13 @@ public:
   const SparseMatrix& minus_w() const { return minus_w_; }
 
 private:
-  void areas_and_adjacency(const Mesh& mesh); // inverse_area_, offsets_, adjacent_, component_
+  void areas_and_adjacency(const Mesh& mesh); // area_, inverse_area_, offsets_, adjacent_, ...
+  void inverse_areas();                       // inverse_area_ from area_
+  void find_components(const Mesh& mesh);     // component_, components_ from the adjacency
   void check_handles_and_components(const Region& region) const;
 
   SparseMatrix minus_w_;
+  Eigen::VectorXd area_;                // the mixed vertex areas
   Eigen::VectorXd inverse_area_;        // 1 / mixed area, floored (see kharmonic.cpp)
   std::vector<int> offsets_, adjacent_; // the one-ring of every vertex (edges of the mesh)
   std::vector<int> component_;          // connected component of every vertex

@@ -14,7 +14,8 @@
 //      spliced back (mesh/splice.h). Both correspondences are carried over and mended where the
 //      base moved; the report's base figures are updated where the base changed.
 //   4. The new editor adopts O', S', the filter (O's, shared: the metric stays the one the
-//      editor was built with), the base and the correspondences (Editor(EditorParts, ...)).
+//      editor was built with), the base and the correspondences (Editor(EditorParts, ...)), and
+//      the old editor's Laplacian assembler updated where the base changed (linalg/kharmonic.h).
 //
 // Where the local bake cannot work (no remeshed base, feature lines, a band or patch covering
 // most of the mesh, a patch without border, a failure on the way), bake() preprocesses O' in
@@ -60,8 +61,9 @@ struct BakeReport {
   std::size_t reference_faces = 0;         ///< faces of S' under the patch
   std::size_t rewalked_input_vertices = 0; ///< input vertices located on the new base by a walk
   /// Wall time: "filter", "base", "patch" (selection and sub-meshes), "remesh", "stitch",
-  /// "report", "editor" (the new editor's construction: its Laplacian assembler), "total"; only
-  /// "total" for the full preprocess.
+  /// "report" (the base's figures, and the assembler on another thread at the same time),
+  /// "assembler" (the old editor's Laplacian assembler updated where the base changed), "editor"
+  /// (the new editor's construction), "total"; only "total" for the full preprocess.
   std::map<std::string, double> milliseconds;
   /// The process's CPU time (all threads) in the same parts: on a busy machine the wall time
   /// says little about a part's own work.

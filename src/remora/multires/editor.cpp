@@ -153,7 +153,7 @@ Editor::Editor(Mesh mesh, EditorOptions options) : impl_(std::make_unique<Impl>(
   m.report.milliseconds["base report"] = ms_since(t0);
 }
 
-Editor::Editor(EditorParts parts, EditorOptions options) : impl_(std::make_unique<Impl>()) {
+Editor::Editor(EditorParts&& parts, EditorOptions options) : impl_(std::make_unique<Impl>()) {
   Impl& m = *impl_;
   check_options(options);
   const auto ni = static_cast<Eigen::Index>(parts.input.n_vertices());
@@ -180,7 +180,10 @@ Editor::Editor(EditorParts parts, EditorOptions options) : impl_(std::make_uniqu
   m.statistics = std::move(parts.statistics);
   m.report = std::move(parts.report);
   m.base_normals = vertex_normals(m.topology, m.base_rest);
-  m.assembler.emplace(m.base, m.options.threads);
+  if (parts.assembler && parts.assembler->vertex_count() == m.base.n_vertices())
+    m.assembler = std::move(parts.assembler);
+  else
+    m.assembler.emplace(m.base, m.options.threads);
 }
 
 Editor::Editor(Editor&&) noexcept = default;
@@ -364,7 +367,7 @@ EditorPartsView Editor::parts() const {
   const Impl& m = *impl_;
   return {m.input,          m.input_positions, m.input_topology, m.filter,        m.smooth,
           m.base,           m.topology,        m.base_rest,      m.base_on_input, m.input_on_base,
-          m.negative_edges, m.statistics,      m.report};
+          m.negative_edges, m.statistics,      m.report,         *m.assembler};
 }
 
 nlohmann::json to_json(const EditReport& r) {

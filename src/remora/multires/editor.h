@@ -28,6 +28,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <optional>
 #include <stop_token>
 #include <string>
 #include <string_view>
@@ -167,6 +168,9 @@ struct EditorParts {
   std::vector<std::pair<int, int>> negative_edges; ///< base edges with a negative cotan weight
   BaseStatistics statistics; ///< per base vertex, what the report's figures sum
   EditReport report;         ///< the base's figures
+  /// The base's Laplacian assembler when the maker has it (the bake updates the old one);
+  /// otherwise the editor builds it.
+  std::optional<KHarmonicAssembler> assembler;
 };
 
 /// The same pieces of an existing editor, read-only (what a bake reads).
@@ -184,6 +188,7 @@ struct EditorPartsView {
   const std::vector<std::pair<int, int>>& negative_edges;
   const BaseStatistics& statistics;
   const EditReport& report;
+  const KHarmonicAssembler& assembler;
 };
 
 struct FrameExport;
@@ -193,9 +198,10 @@ public:
   /// Steps 1-3. `mesh` must be a repaired mesh without deleted elements (read_mesh() gives one).
   /// Throws InvalidArgument for an empty mesh, non-finite points or bad options.
   explicit Editor(Mesh mesh, EditorOptions options = {});
-  /// Steps 1-3 adopted from a bake (multires/bake.h), nothing recomputed; `options` as they made
-  /// the pieces, remesh on. Throws InvalidArgument when the pieces' sizes disagree.
-  Editor(EditorParts parts, EditorOptions options);
+  /// Steps 1-3 adopted from a bake (multires/bake.h): nothing recomputed but the base's normals,
+  /// and the Laplacian assembler when `parts` has none for this base; `options` as they made the
+  /// pieces, remesh on. Throws InvalidArgument when the pieces' sizes disagree.
+  Editor(EditorParts&& parts, EditorOptions options);
   Editor(Editor&&) noexcept;
   Editor& operator=(Editor&&) noexcept;
   ~Editor();
