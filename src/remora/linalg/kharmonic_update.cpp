@@ -48,8 +48,7 @@ void weight_column(const Mesh& mesh, VertexHandle v, std::vector<std::pair<int, 
     out.emplace_back(w, weight);
   }
   out.emplace_back(v.idx(), diagonal);
-  std::sort(out.begin(), out.end(),
-            [](const auto& a, const auto& b) { return a.first < b.first; });
+  std::sort(out.begin(), out.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
 }
 
 void check_update_sizes(const Mesh& mesh, std::size_t previous_vertices,
