@@ -6,6 +6,7 @@
 #include <limits>
 #include <numbers>
 
+#include "remora/common/parallel.h"
 #include "remora/geometry/laplacian.h"
 #include "remora/geometry/measures.h"
 #include "remora/geometry/per_face.h"
@@ -163,12 +164,15 @@ void update_base_figures(const Mesh& old, const MeshQuality& quality,
     s.rows[to] = statistics.rows[v];
   }
   std::vector<char> done(base.n_vertices(), 0);
+  std::vector<VertexHandle> measure;
   for (const int f : change.new_faces)
     for (const VertexHandle v : base.fv_range(FaceHandle(f)))
       if (!done[static_cast<std::size_t>(v.idx())]) {
         done[static_cast<std::size_t>(v.idx())] = 1;
-        vertex_statistics(base, v, s, v.idx());
+        measure.push_back(v);
       }
+  parallel_for(measure.size(), 0,
+               [&](std::size_t i) { vertex_statistics(base, measure[i], s, measure[i].idx()); });
   defect = symmetry_defect(base, s);
 
   q = MeshQuality{};
