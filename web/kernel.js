@@ -42,6 +42,7 @@ export function parseKernel(buffer) {
   };
   if (at !== buffer.byteLength || columns !== 3 + 4 * handles)
     throw new Error(`region kernel: ${buffer.byteLength} bytes, its header describes ${at}`);
+  sortRecords(k);
   let ringFaces = 0;
   for (let i = 0; i < k.ring.length; ++i) ringFaces = Math.max(ringFaces, k.ring[i] + 1);
   k.ringFaces = ringFaces; // the normals' faces come first among the faces
@@ -65,6 +66,27 @@ export function parseKernel(buffer) {
     k.pivots.push(o);
   }
   return k;
+}
+
+/// Puts the records in the order of their faces' first corners. The server sends them in the
+/// order of their outputs (the input's vertex order, which can be anywhere in the base: a
+/// subdivided scan's is), and the decode then reads its three rows from anywhere; in this order
+/// it reads them nearly in sequence and scatters only its writes. The frames are the same numbers.
+function sortRecords(k) {
+  const order = Uint32Array.from({ length: k.records }, (_, i) => i);
+  const first = (i) => k.faces[3 * k.recordFace[i]];
+  order.sort((a, b) => first(a) - first(b) || a - b);
+  const pick = (array, width) => {
+    if (!array) return array;
+    const out = new array.constructor(array.length);
+    for (let i = 0; i < order.length; ++i)
+      out.set(array.subarray(width * order[i], width * order[i] + width), width * i);
+    return out;
+  };
+  Object.assign(k, {
+    recordFace: pick(k.recordFace, 1), recordSlot: pick(k.recordSlot, 1), recordBary: pick(k.recordBary, 3),
+    recordOffset: pick(k.recordOffset, 1), recordResidual: pick(k.recordResidual, 1), offsets: pick(k.offsets, 3),
+  });
 }
 
 /// Positions (x, y, z per slot, the order of the region's movable vertices) into `out`
