@@ -135,21 +135,35 @@ KHarmonicAssembler::KHarmonicAssembler(const Mesh& mesh, const KHarmonicAssemble
   double* values = minus_w_.valuePtr();
   parallel_for(n, threads, [&](std::size_t v) {
     thread_local std::vector<std::pair<int, double>> entries;
+    const auto at = static_cast<std::size_t>(outer[v]);
     if (dirty[v]) {
       weight_column(mesh, VertexHandle(static_cast<int>(v)), entries);
-      for (auto& entry : entries) entry.second = -entry.second;
-    } else {
-      const int o = previous_of[v];
-      entries.clear();
-      for (int k = earlier.outerIndexPtr()[o]; k < earlier.outerIndexPtr()[o + 1]; ++k)
-        entries.emplace_back(current(earlier.innerIndexPtr()[k]), earlier.valuePtr()[k]);
-      if (!std::is_sorted(entries.begin(), entries.end()))
-        std::sort(entries.begin(), entries.end(),
-                  [](const auto& a, const auto& b) { return a.first < b.first; });
+      for (std::size_t k = 0; k < entries.size(); ++k) {
+        rows[at + k] = entries[k].first;
+        values[at + k] = -entries[k].second;
+      }
+      return;
     }
+    // The earlier column, its rows renumbered; sorted again only where the renumbering moved a
+    // neighbour past another (the splice moves the last vertices into the places it frees).
+    const int o = previous_of[v];
+    const int begin = earlier.outerIndexPtr()[o], end = earlier.outerIndexPtr()[o + 1];
+    bool sorted = true;
+    for (int k = begin; k < end; ++k) {
+      const std::size_t e = at + static_cast<std::size_t>(k - begin);
+      rows[e] = current(earlier.innerIndexPtr()[k]);
+      values[e] = earlier.valuePtr()[k];
+      sorted = sorted && (k == begin || rows[e - 1] < rows[e]);
+    }
+    if (sorted) return;
+    entries.clear();
+    for (std::size_t e = at; e < at + static_cast<std::size_t>(end - begin); ++e)
+      entries.emplace_back(rows[e], values[e]);
+    std::sort(entries.begin(), entries.end(),
+              [](const auto& x, const auto& y) { return x.first < y.first; });
     for (std::size_t k = 0; k < entries.size(); ++k) {
-      rows[static_cast<std::size_t>(outer[v]) + k] = entries[k].first;
-      values[static_cast<std::size_t>(outer[v]) + k] = entries[k].second;
+      rows[at + k] = entries[k].first;
+      values[at + k] = entries[k].second;
     }
   });
   rest.get();
