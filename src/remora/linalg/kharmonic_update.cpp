@@ -78,7 +78,8 @@ KHarmonicAssembler::KHarmonicAssembler(const Mesh& mesh, const KHarmonicAssemble
   check_update_sizes(mesh, previous.vertex_count(), previous_of, changed);
   const std::size_t n = mesh.n_vertices();
   const std::vector<char> dirty = reached(mesh, changed);
-  // An unchanged vertex's neighbours are unchanged too (they share a face with it).
+  // Earlier vertex -> vertex, for the unchanged ones. The neighbours of a vertex that no changed
+  // vertex touches are unchanged (each shares a face with it), so its copy needs only these.
   std::vector<int> current_of(previous.vertex_count(), -1);
   for (std::size_t v = 0; v < n; ++v)
     if (!changed[v]) current_of[static_cast<std::size_t>(previous_of[v])] = static_cast<int>(v);
