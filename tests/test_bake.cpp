@@ -181,6 +181,9 @@ TEST(Bake, MatchesAFullPreprocessAndKeepsTheRestBitForBit) {
     EXPECT_EQ(qr.components, ql.components);
     EXPECT_EQ(qr.vertices, ql.vertices);
     EXPECT_TRUE(near(report.base_symmetry_defect, laplacian_symmetry_defect(local.editor.base())));
+    // The base's normals, carried over where no face around them changed: vertex_normals()'s bits.
+    const EditorPartsView lp = local.editor.parts();
+    EXPECT_EQ(lp.base_normals, vertex_normals(lp.topology, lp.base_rest));
     // The Laplacian assembler, carried over from the old editor where the base did not change,
     // is the new base's: −W to round-off in the diagonal, the same systems.
     const KHarmonicAssembler fresh(local.editor.base());

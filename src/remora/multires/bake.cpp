@@ -13,6 +13,7 @@
 
 #include "remora/common/timer.h"
 #include "remora/multires/bake_steps.h"
+#include "remora/multires/phong.h"
 
 namespace remora {
 
@@ -122,6 +123,39 @@ void update_assembler(const Bake& b, const SpliceMap* map, EditorParts& parts) {
   parts.assembler.emplace(parts.base, b.old.assembler, previous_of, changed, b.options.threads);
 }
 
+// B's vertex normals: the old ones renumbered, and measured again (update_vertex_normals(), the
+// same bits as vertex_normals()) around every face that is new, has a moved corner or changed
+// its index, which could change the order of a vertex's faces and so its sum.
+void carry_normals(const Bake& b, const SpliceMap* map, EditorParts& parts) {
+  const auto n = static_cast<Eigen::Index>(parts.base.n_vertices());
+  parts.base_normals.resize(n, 3);
+  for (std::size_t o = 0; o < b.moved.size(); ++o) {
+    const int v = map ? map->vertices[o] : static_cast<int>(o);
+    if (v >= 0) parts.base_normals.row(v) = b.old.base_normals.row(static_cast<Eigen::Index>(o));
+  }
+  std::vector<char> touched(static_cast<std::size_t>(n), 0);
+  const auto touch = [&](int f) {
+    for (const int v : parts.topology.faces[static_cast<std::size_t>(f)])
+      touched[static_cast<std::size_t>(v)] = 1;
+  };
+  if (map)
+    for (const int f : map->patch_faces) touch(f);
+  const TriangleTopology& old = b.old.topology;
+  for (std::size_t f = 0; f < old.faces.size(); ++f) {
+    const int to = map ? map->faces[f] : static_cast<int>(f);
+    if (to < 0) continue;
+    const auto& c = old.faces[f];
+    if (to != static_cast<int>(f) || b.moved[static_cast<std::size_t>(c[0])] ||
+        b.moved[static_cast<std::size_t>(c[1])] || b.moved[static_cast<std::size_t>(c[2])])
+      touch(to);
+  }
+  std::vector<int> vertices;
+  for (std::size_t v = 0; v < touched.size(); ++v)
+    if (touched[v]) vertices.push_back(static_cast<int>(v));
+  update_vertex_normals(parts.topology, parts.base_rest, vertices, parts.base_normals,
+                        b.options.threads);
+}
+
 // The report's figures and the assembler read only the new base: they run at once, the assembler
 // on another thread. "report" is the wall and CPU time of both, "assembler" its own wall time.
 template <class Timed>
@@ -180,6 +214,7 @@ EditorParts local_parts(const Editor& editor, const Eigen::MatrixXd& positions,
   if (!has_patch) {
     EditorParts parts = timed(report, "stitch", [&] { return stitch(b, nullptr, nullptr, map); });
     figures_and_assembler(b, parts, nullptr, timer);
+    timed(report, "normals", [&] { carry_normals(b, nullptr, parts); });
     return parts;
   }
   const PatchMeshes meshes = timed(report, "patch", [&] { return patch_meshes(b); });
@@ -197,6 +232,7 @@ EditorParts local_parts(const Editor& editor, const Eigen::MatrixXd& positions,
   progress(3);
   EditorParts parts = timed(report, "stitch", [&] { return stitch(b, &meshes, &remeshed, map); });
   figures_and_assembler(b, parts, &map, timer);
+  timed(report, "normals", [&] { carry_normals(b, &map, parts); });
   return parts;
 }
 

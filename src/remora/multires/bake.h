@@ -15,7 +15,8 @@
 //      base moved; the report's base figures are updated where the base changed.
 //   4. The new editor adopts O', S', the filter (O's, shared: the metric stays the one the
 //      editor was built with), the base and the correspondences (Editor(EditorParts, ...)), and
-//      the old editor's Laplacian assembler updated where the base changed (linalg/kharmonic.h).
+//      the old editor's Laplacian assembler (linalg/kharmonic.h) and base normals updated where
+//      the base changed.
 //
 // Where the local bake cannot work (no remeshed base, feature lines, a band or patch covering
 // most of the mesh, a patch without border, a failure on the way), bake() preprocesses O' in
@@ -62,8 +63,9 @@ struct BakeReport {
   std::size_t rewalked_input_vertices = 0; ///< input vertices located on the new base by a walk
   /// Wall time: "filter", "base", "patch" (selection and sub-meshes), "remesh", "stitch",
   /// "report" (the base's figures, and the assembler on another thread at the same time),
-  /// "assembler" (the old editor's Laplacian assembler updated where the base changed), "editor"
-  /// (the new editor's construction), "total"; only "total" for the full preprocess.
+  /// "assembler" (the old editor's Laplacian assembler updated where the base changed),
+  /// "normals" (the base's normals, likewise), "editor" (the new editor's construction), "total";
+  /// only "total" for the full preprocess.
   std::map<std::string, double> milliseconds;
   /// The process's CPU time (all threads) in the same parts: on a busy machine the wall time
   /// says little about a part's own work.

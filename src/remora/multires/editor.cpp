@@ -179,7 +179,10 @@ Editor::Editor(EditorParts&& parts, EditorOptions options) : impl_(std::make_uni
   m.negative_edges = std::move(parts.negative_edges);
   m.statistics = std::move(parts.statistics);
   m.report = std::move(parts.report);
-  m.base_normals = vertex_normals(m.topology, m.base_rest);
+  if (parts.base_normals.rows() == nb && parts.base_normals.cols() == 3)
+    m.base_normals = std::move(parts.base_normals);
+  else
+    m.base_normals = vertex_normals(m.topology, m.base_rest);
   if (parts.assembler && parts.assembler->vertex_count() == m.base.n_vertices())
     m.assembler = std::move(parts.assembler);
   else
@@ -367,7 +370,7 @@ EditorPartsView Editor::parts() const {
   const Impl& m = *impl_;
   return {m.input,          m.input_positions, m.input_topology, m.filter,        m.smooth,
           m.base,           m.topology,        m.base_rest,      m.base_on_input, m.input_on_base,
-          m.negative_edges, m.statistics,      m.report,         *m.assembler};
+          m.negative_edges, m.statistics,      m.report,         *m.assembler,    m.base_normals};
 }
 
 nlohmann::json to_json(const EditReport& r) {

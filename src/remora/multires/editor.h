@@ -171,6 +171,9 @@ struct EditorParts {
   /// The base's Laplacian assembler when the maker has it (the bake updates the old one);
   /// otherwise the editor builds it.
   std::optional<KHarmonicAssembler> assembler;
+  /// B's vertex normals (vertex_normals() of topology and base_rest) when the maker has them;
+  /// empty: the editor computes them.
+  Eigen::MatrixXd base_normals;
 };
 
 /// The same pieces of an existing editor, read-only (what a bake reads).
@@ -189,6 +192,7 @@ struct EditorPartsView {
   const BaseStatistics& statistics;
   const EditReport& report;
   const KHarmonicAssembler& assembler;
+  const Eigen::MatrixXd& base_normals;
 };
 
 struct FrameExport;
@@ -198,8 +202,8 @@ public:
   /// Steps 1-3. `mesh` must be a repaired mesh without deleted elements (read_mesh() gives one).
   /// Throws InvalidArgument for an empty mesh, non-finite points or bad options.
   explicit Editor(Mesh mesh, EditorOptions options = {});
-  /// Steps 1-3 adopted from a bake (multires/bake.h): nothing recomputed but the base's normals,
-  /// and the Laplacian assembler when `parts` has none for this base; `options` as they made the
+  /// Steps 1-3 adopted from a bake (multires/bake.h): nothing recomputed but the base's normals
+  /// and its Laplacian assembler where `parts` has none for this base; `options` as they made the
   /// pieces, remesh on. Throws InvalidArgument when the pieces' sizes disagree.
   Editor(EditorParts&& parts, EditorOptions options);
   Editor(Editor&&) noexcept;
