@@ -156,23 +156,6 @@ void carry_normals(const Bake& b, const SpliceMap* map, EditorParts& parts) {
                         b.options.threads);
 }
 
-// The report's figures and the assembler read only the new base: they run at once, the assembler
-// on another thread. "report" is the wall and CPU time of both, "assembler" its own wall time.
-template <class Timed>
-void figures_and_assembler(const Bake& b, EditorParts& parts, const SpliceMap* map, Timed&& timed) {
-  double assembler_ms = 0;
-  timed("report", [&] {
-    auto job = std::async(b.options.threads == 1 ? std::launch::deferred : std::launch::async, [&] {
-      const auto t0 = Clock::now();
-      update_assembler(b, map, parts);
-      assembler_ms = ms_since(t0);
-    });
-    base_figures(b, parts, map);
-    job.get();
-  });
-  b.report.milliseconds["assembler"] = assembler_ms;
-}
-
 // The process's CPU time in milliseconds.
 double cpu_ms() {
   timespec t{};
@@ -196,6 +179,22 @@ auto timed(BakeReport& report, const char* part, F&& f) {
   return f();
 }
 
+// The report's figures and the assembler read only the new base: they run at once, the assembler
+// on another thread. "report" is the wall and CPU time of both, "assembler" its own wall time.
+void figures_and_assembler(const Bake& b, EditorParts& parts, const SpliceMap* map) {
+  double assembler_ms = 0;
+  timed(b.report, "report", [&] {
+    auto job = std::async(b.options.threads == 1 ? std::launch::deferred : std::launch::async, [&] {
+      const auto t0 = Clock::now();
+      update_assembler(b, map, parts);
+      assembler_ms = ms_since(t0);
+    });
+    base_figures(b, parts, map);
+    job.get();
+  });
+  b.report.milliseconds["assembler"] = assembler_ms;
+}
+
 // Steps 1-3 of bake.h; throws NotLocal (or what a step throws) where they cannot work.
 EditorParts local_parts(const Editor& editor, const Eigen::MatrixXd& positions,
                         const BakeOptions& settings, BakeReport& report) {
@@ -204,7 +203,6 @@ EditorParts local_parts(const Editor& editor, const Eigen::MatrixXd& positions,
   auto progress = [&](int step) {
     if (options.progress) options.progress("bake", step, 4);
   };
-  const auto timer = [&](const char* part, auto&& f) { return timed(report, part, f); };
   progress(0);
   timed(report, "filter", [&] { filter_band(b); });
   timed(report, "base", [&] { move_base(b); });
@@ -213,7 +211,7 @@ EditorParts local_parts(const Editor& editor, const Eigen::MatrixXd& positions,
   const bool has_patch = timed(report, "patch", [&] { return select_patch(b); });
   if (!has_patch) {
     EditorParts parts = timed(report, "stitch", [&] { return stitch(b, nullptr, nullptr, map); });
-    figures_and_assembler(b, parts, nullptr, timer);
+    figures_and_assembler(b, parts, nullptr);
     timed(report, "normals", [&] { carry_normals(b, nullptr, parts); });
     return parts;
   }
@@ -231,7 +229,7 @@ EditorParts local_parts(const Editor& editor, const Eigen::MatrixXd& positions,
   report.patch_faces_after = remeshed.mesh.n_faces();
   progress(3);
   EditorParts parts = timed(report, "stitch", [&] { return stitch(b, &meshes, &remeshed, map); });
-  figures_and_assembler(b, parts, &map, timer);
+  figures_and_assembler(b, parts, &map);
   timed(report, "normals", [&] { carry_normals(b, &map, parts); });
   return parts;
 }
