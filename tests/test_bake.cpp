@@ -18,6 +18,7 @@
 #include "remora/mesh/io.h"
 #include "remora/mesh/primitives.h"
 #include "remora/multires/bake.h"
+#include "remora/multires/base_figures.h"
 #include "support.h"
 
 namespace remora {
@@ -178,9 +179,23 @@ TEST(Bake, MatchesAFullPreprocessAndKeepsTheRestBitForBit) {
     EXPECT_TRUE(near(qr.edge_length.cv, ql.edge_length.cv));
     EXPECT_EQ(qr.edge_length.max, ql.edge_length.max);
     EXPECT_EQ(qr.valence.interior, ql.valence.interior);
+    EXPECT_EQ(qr.valence.boundary, ql.valence.boundary);
+    EXPECT_EQ(qr.valence.percent_interior_6, ql.valence.percent_interior_6);
+    EXPECT_EQ(qr.interior_vertices, ql.interior_vertices);
+    EXPECT_EQ(qr.boundary_vertices, ql.boundary_vertices);
+    EXPECT_TRUE(near(qr.barycentric_area.rel_std, ql.barycentric_area.rel_std));
     EXPECT_EQ(qr.components, ql.components);
     EXPECT_EQ(qr.vertices, ql.vertices);
     EXPECT_TRUE(near(report.base_symmetry_defect, laplacian_symmetry_defect(local.editor.base())));
+    // The statistics those figures sum, per vertex, against the base's measured afresh.
+    const BaseStatistics fresh_statistics = base_statistics(local.editor.base());
+    const BaseStatistics& carried_statistics = local.editor.parts().statistics;
+    for (const auto member : {&BaseStatistics::mixed_areas, &BaseStatistics::barycentric_areas,
+                              &BaseStatistics::rows}) {
+      const Eigen::VectorXd& expected = fresh_statistics.*member;
+      EXPECT_LE((carried_statistics.*member - expected).cwiseAbs().maxCoeff(),
+                1e-12 * expected.cwiseAbs().maxCoeff());
+    }
     // The base's normals, carried over where no face around them changed: vertex_normals()'s bits.
     const EditorPartsView lp = local.editor.parts();
     EXPECT_EQ(lp.base_normals, vertex_normals(lp.topology, lp.base_rest));

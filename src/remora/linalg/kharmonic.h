@@ -109,6 +109,8 @@ public:
   std::size_t vertex_count() const { return static_cast<std::size_t>(offsets_.size() - 1); }
   /// −W (column-major, symmetric).
   const SparseMatrix& minus_w() const { return minus_w_; }
+  /// The mixed vertex areas (vertex_areas_mixed(), unfloored).
+  const Eigen::VectorXd& areas() const { return area_; }
 
 private:
   void areas_and_adjacency(const Mesh& mesh); // area_, inverse_area_, offsets_, adjacent_, ...

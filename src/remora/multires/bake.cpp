@@ -179,19 +179,33 @@ auto timed(BakeReport& report, const char* part, F&& f) {
   return f();
 }
 
-// The report's figures and the assembler read only the new base: they run at once, the assembler
-// on another thread. "report" is the wall and CPU time of both, "assembler" its own wall time.
-void figures_and_assembler(const Bake& b, EditorParts& parts, const SpliceMap* map) {
+// The steps after the splice, on two threads. The second updates the old editor's assembler to
+// the new base, then the base's vertex statistics and the figures over them from it; it reads the
+// old editor, the new base and the map, and writes parts.assembler and parts.statistics. The
+// first copies the input, mends the correspondence and updates the other figures and the
+// normals. "assembler" is the second thread's wall time, "wait" the first's wait for it.
+void finish(Bake& b, const PatchMeshes* meshes, const RemeshPatchResult* remeshed,
+            const SpliceMap* map, EditorParts& parts) {
+  const BaseChange change = timed(b.report, "report", [&] { return base_change(b, map); });
   double assembler_ms = 0;
-  timed(b.report, "report", [&] {
-    auto job = std::async(b.options.threads == 1 ? std::launch::deferred : std::launch::async, [&] {
-      const auto t0 = Clock::now();
-      update_assembler(b, map, parts);
-      assembler_ms = ms_since(t0);
-    });
-    base_figures(b, parts, map);
-    job.get();
+  VertexFigures figures;
+  auto job = std::async(b.options.threads == 1 ? std::launch::deferred : std::launch::async, [&] {
+    const auto t0 = Clock::now();
+    update_assembler(b, map, parts);
+    figures = update_vertex_figures(b.old.statistics, parts.base, change, *parts.assembler,
+                                    parts.statistics);
+    assembler_ms = ms_since(t0);
   });
+  timed(b.report, "mend", [&] {
+    carry_input(b, parts);
+    mend(b, meshes, remeshed, map, parts);
+  });
+  timed(b.report, "report", [&] { base_figures(b, change, parts, map); });
+  timed(b.report, "normals", [&] { carry_normals(b, map, parts); });
+  timed(b.report, "wait", [&] { job.get(); });
+  parts.report.base_quality.mixed_area = figures.mixed_area;
+  parts.report.base_quality.barycentric_area = figures.barycentric_area;
+  parts.report.base_symmetry_defect = figures.symmetry_defect;
   b.report.milliseconds["assembler"] = assembler_ms;
 }
 
@@ -211,8 +225,7 @@ EditorParts local_parts(const Editor& editor, const Eigen::MatrixXd& positions,
   const bool has_patch = timed(report, "patch", [&] { return select_patch(b); });
   if (!has_patch) {
     EditorParts parts = timed(report, "stitch", [&] { return stitch(b, nullptr, nullptr, map); });
-    figures_and_assembler(b, parts, nullptr);
-    timed(report, "normals", [&] { carry_normals(b, nullptr, parts); });
+    finish(b, nullptr, nullptr, nullptr, parts);
     return parts;
   }
   const PatchMeshes meshes = timed(report, "patch", [&] { return patch_meshes(b); });
@@ -229,8 +242,7 @@ EditorParts local_parts(const Editor& editor, const Eigen::MatrixXd& positions,
   report.patch_faces_after = remeshed.mesh.n_faces();
   progress(3);
   EditorParts parts = timed(report, "stitch", [&] { return stitch(b, &meshes, &remeshed, map); });
-  figures_and_assembler(b, parts, &map);
-  timed(report, "normals", [&] { carry_normals(b, &map, parts); });
+  finish(b, &meshes, &remeshed, &map, parts);
   return parts;
 }
 

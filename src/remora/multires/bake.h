@@ -61,11 +61,12 @@ struct BakeReport {
   std::size_t patch_faces_after = 0;       ///< the faces that replaced them
   std::size_t reference_faces = 0;         ///< faces of S' under the patch
   std::size_t rewalked_input_vertices = 0; ///< input vertices located on the new base by a walk
-  /// Wall time: "filter", "base", "patch" (selection and sub-meshes), "remesh", "stitch",
-  /// "report" (the base's figures, and the assembler on another thread at the same time),
-  /// "assembler" (the old editor's Laplacian assembler updated where the base changed),
-  /// "normals" (the base's normals, likewise), "editor" (the new editor's construction), "total";
-  /// only "total" for the full preprocess.
+  /// Wall time: "filter", "base", "patch" (selection and sub-meshes), "remesh", "stitch" (the
+  /// splice), then on one thread "mend" (the input copied and located on the new base), "report"
+  /// (the base's figures), "normals" (the base's normals, updated where it changed) and "wait"
+  /// (for the second thread), while the second builds the "assembler" (the old editor's
+  /// Laplacian assembler updated where the base changed); "editor" (the new editor's
+  /// construction), "total"; only "total" for the full preprocess.
   std::map<std::string, double> milliseconds;
   /// The process's CPU time (all threads) in the same parts: on a busy machine the wall time
   /// says little about a part's own work.

@@ -55,13 +55,25 @@ bool select_patch(Bake& b);
 /// The patch and its reference as meshes (bake_patch.cpp). Throws NotLocal when a part of the
 /// patch has no border.
 PatchMeshes patch_meshes(const Bake& b);
-/// The new editor's pieces: the base with `remeshed` spliced in place of the patch (`map` says
-/// where its elements went), or B' alone when there is none, and both correspondences. Throws
-/// NotLocal when a correspondence cannot be carried over.
-EditorParts stitch(Bake& b, const PatchMeshes* meshes, const RemeshPatchResult* remeshed,
+/// The new editor's base: `remeshed` spliced in place of the patch (`map` says where its elements
+/// went), or B' alone when there is none (`meshes` and `remeshed` null); with its correspondence
+/// to the input. The other parts are left to carry_input() and mend().
+EditorParts stitch(const Bake& b, const PatchMeshes* meshes, const RemeshPatchResult* remeshed,
                    SpliceMap& map);
-/// The new base's figures into parts.report, its negative cotan edges and statistics: updated
-/// where the base changed (`map` as stitch() made it; null without a patch).
-void base_figures(const Bake& b, EditorParts& parts, const SpliceMap* map);
+/// The new editor's input, its topology and filter: the old ones, with O' in the band. Touches no
+/// part that stitch() or mend() writes.
+void carry_input(const Bake& b, EditorParts& parts);
+/// The new editor's input on the base (each input vertex located again where the base or S' moved
+/// under it), O', S' (moved out of b), the base's topology and rest positions. Throws NotLocal
+/// when the correspondence cannot be carried over. `map` is null without a patch.
+void mend(Bake& b, const PatchMeshes* meshes, const RemeshPatchResult* remeshed,
+          const SpliceMap* map, EditorParts& parts);
+/// What the bake changed in the base (base_figures.h): the patch's faces, old and new, and the
+/// kept faces with a moved corner (`map` as stitch() made it; null without a patch).
+BaseChange base_change(const Bake& b, const SpliceMap* map);
+/// The new base's figures into parts.report and its negative cotan edges, updated where the
+/// base changed, all but those over the vertex statistics (update_vertex_figures()).
+void base_figures(const Bake& b, const BaseChange& change, EditorParts& parts,
+                  const SpliceMap* map);
 
 } // namespace remora::bake_detail

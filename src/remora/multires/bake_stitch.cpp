@@ -84,6 +84,8 @@ std::vector<SurfacePoint> mend_input_on_base(const Bake& b, const Mesh& base, co
 
 // What the bake changed in the base (base_figures.h): the patch's faces, old and new, and the
 // kept faces with a moved corner.
+} // namespace
+
 BaseChange base_change(const Bake& b, const SpliceMap* map) {
   BaseChange c;
   if (map) {
@@ -104,6 +106,8 @@ BaseChange base_change(const Bake& b, const SpliceMap* map) {
   }
   return c;
 }
+
+namespace {
 
 // The base's edges with a negative cotan weight: the old ones where no face around them changed,
 // and those around the changed faces measured again.
@@ -147,7 +151,8 @@ std::vector<std::pair<int, int>> negative_edges(const Bake& b, const Mesh& base,
 
 // The base's figures for the report: the topological ones (the bake keeps the topology) from the
 // old report, the others updated where the base changed (base_figures.h).
-void base_figures(const Bake& b, EditorParts& parts, const SpliceMap* map) {
+void base_figures(const Bake& b, const BaseChange& change, EditorParts& parts,
+                  const SpliceMap* map) {
   EditReport& r = parts.report;
   const EditReport& old = b.old.report;
   r.remeshed = true;
@@ -162,10 +167,8 @@ void base_figures(const Bake& b, EditorParts& parts, const SpliceMap* map) {
   r.base_target_length = old.base_target_length;
   r.base_vertices = parts.base.n_vertices();
   r.base_faces = parts.base.n_faces();
-  const BaseChange change = base_change(b, map);
   parts.negative_edges = negative_edges(b, parts.base, map, change);
-  update_base_figures(b.old.base, old.base_quality, b.old.statistics, parts.base, change,
-                      r.base_quality, r.base_symmetry_defect, parts.statistics);
+  update_mesh_figures(b.old.base, old.base_quality, parts.base, change, r.base_quality);
   if (r.base_quality.component_topology.size() == 1) {
     ComponentTopology& c = r.base_quality.component_topology.front();
     c.vertices = static_cast<int>(r.base_quality.vertices);
@@ -176,16 +179,9 @@ void base_figures(const Bake& b, EditorParts& parts, const SpliceMap* map) {
   }
 }
 
-EditorParts stitch(Bake& b, const PatchMeshes* m, const RemeshPatchResult* r, SpliceMap& map) {
+EditorParts stitch(const Bake& b, const PatchMeshes* m, const RemeshPatchResult* r,
+                   SpliceMap& map) {
   EditorParts parts;
-  parts.input = b.old.input;
-  for (std::size_t i = 0; i < b.in_band.size(); ++i)
-    if (b.in_band[i])
-      parts.input.set_point(VertexHandle(static_cast<int>(i)),
-                            row_point(b.input_positions, static_cast<Eigen::Index>(i)));
-  parts.input_positions = b.input_positions;
-  parts.input_topology = b.old.input_topology;
-  parts.filter = b.old.filter;
   if (m) {
     parts.base = stitched_base(b, *m, *r, parts.base_on_input, map);
   } else {
@@ -196,11 +192,26 @@ EditorParts stitch(Bake& b, const PatchMeshes* m, const RemeshPatchResult* r, Sp
                              row_point(b.base_points, static_cast<Eigen::Index>(v)));
     parts.base_on_input = b.old.base_on_input;
   }
-  parts.input_on_base = mend_input_on_base(b, parts.base, m, r, m ? &map : nullptr);
+  return parts;
+}
+
+void carry_input(const Bake& b, EditorParts& parts) {
+  parts.input = b.old.input;
+  for (std::size_t i = 0; i < b.in_band.size(); ++i)
+    if (b.in_band[i])
+      parts.input.set_point(VertexHandle(static_cast<int>(i)),
+                            row_point(b.input_positions, static_cast<Eigen::Index>(i)));
+  parts.input_topology = b.old.input_topology;
+  parts.filter = b.old.filter;
+}
+
+void mend(Bake& b, const PatchMeshes* m, const RemeshPatchResult* r, const SpliceMap* map,
+          EditorParts& parts) {
+  parts.input_on_base = mend_input_on_base(b, parts.base, m, r, map);
+  parts.input_positions = b.input_positions;
   parts.smooth = std::move(b.smooth);
   parts.topology = m ? triangle_topology(parts.base) : b.old.topology;
   parts.base_rest = positions_matrix(parts.base);
-  return parts;
 }
 
 } // namespace remora::bake_detail

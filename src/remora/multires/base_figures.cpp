@@ -4,8 +4,12 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <numbers>
 
+#include <fmt/format.h>
+
+#include "remora/common/error.h"
 #include "remora/common/parallel.h"
 #include "remora/geometry/laplacian.h"
 #include "remora/geometry/measures.h"
@@ -79,25 +83,48 @@ double add_faces(const Mesh& mesh, const std::vector<int>& faces, double sign, d
   return zero_area;
 }
 
-// One vertex's statistics on `mesh`, from its faces and edges.
-void vertex_statistics(const Mesh& mesh, VertexHandle v, BaseStatistics& s, Eigen::Index at) {
-  double mixed = 0, barycentric = 0, diagonal = 0, squares = 0;
-  for (const FaceHandle f : mesh.vf_range(v)) {
-    const auto fv = face_vertices(mesh, f);
-    const auto parts =
-        triangle_mixed_areas(mesh.point(fv[0]), mesh.point(fv[1]), mesh.point(fv[2]));
-    for (int k = 0; k < 3; ++k)
-      if (fv[static_cast<std::size_t>(k)] == v) mixed += parts[static_cast<std::size_t>(k)];
-    barycentric += face_area(mesh, f) / 3.0;
-  }
-  for (const HalfedgeHandle h : mesh.voh_range(v)) {
-    const double w = cotan_weight(mesh, mesh.edge_handle(h));
-    diagonal -= w;
-    squares += w * w;
-  }
-  s.mixed_areas[at] = mixed;
-  s.barycentric_areas[at] = barycentric;
-  s.rows[at] = squares + diagonal * diagonal;
+// mesh_quality()'s vertex counts and valence histograms over the vertices of `faces` (each once),
+// added to `q` with `sign`.
+void add_vertex_classes(const Mesh& mesh, const std::vector<int>& faces, long sign,
+                        MeshQuality& q) {
+  std::vector<char> seen(mesh.n_vertices(), 0);
+  const auto step = static_cast<std::size_t>(sign); // modular: -1 subtracts one
+  for (const int f : faces)
+    for (const VertexHandle v : mesh.fv_range(FaceHandle(f))) {
+      if (seen[static_cast<std::size_t>(v.idx())]) continue;
+      seen[static_cast<std::size_t>(v.idx())] = 1;
+      const int valence = static_cast<int>(mesh.valence(v));
+      if (mesh.is_boundary(v)) {
+        q.boundary_vertices += step;
+        q.valence.boundary[valence] += step;
+      } else {
+        q.interior_vertices += step;
+        q.valence.interior[valence] += step;
+      }
+    }
+}
+
+// The counts and valences of mesh_quality(): the old ones less the old faces' vertices plus the
+// new faces'. A vertex on neither keeps its faces, so its valence and side.
+void update_valences(const Mesh& old, const MeshQuality& quality, const Mesh& base,
+                     const BaseChange& change, MeshQuality& q) {
+  q.interior_vertices = quality.interior_vertices;
+  q.boundary_vertices = quality.boundary_vertices;
+  q.isolated_vertices = quality.isolated_vertices;
+  q.valence = quality.valence;
+  add_vertex_classes(old, change.old_faces, -1, q);
+  add_vertex_classes(base, change.new_faces, 1, q);
+  for (auto* histogram : {&q.valence.interior, &q.valence.boundary})
+    std::erase_if(*histogram, [](const auto& entry) { return entry.second == 0; });
+  const auto count = [](const std::map<int, std::size_t>& h, int valence) {
+    const auto it = h.find(valence);
+    return it == h.end() ? std::size_t{0} : it->second;
+  };
+  const auto percent = [](std::size_t part, std::size_t whole) {
+    return whole == 0 ? 0.0 : 100.0 * static_cast<double>(part) / static_cast<double>(whole);
+  };
+  q.valence.percent_interior_6 = percent(count(q.valence.interior, 6), q.interior_vertices);
+  q.valence.percent_boundary_4 = percent(count(q.valence.boundary, 4), q.boundary_vertices);
 }
 
 } // namespace
@@ -146,35 +173,47 @@ double symmetry_defect(const Mesh& base, const BaseStatistics& s) {
   return r2 > 0 ? std::sqrt(std::max(0.0, difference) / r2) : 0.0;
 }
 
-void update_base_figures(const Mesh& old, const MeshQuality& quality,
-                         const BaseStatistics& statistics, const Mesh& base,
-                         const BaseChange& change, MeshQuality& q, double& defect,
-                         BaseStatistics& s) {
-  // The vertex statistics: carried over, then measured again around the new faces.
+VertexFigures update_vertex_figures(const BaseStatistics& statistics, const Mesh& base,
+                                    const BaseChange& change, const KHarmonicAssembler& assembler,
+                                    BaseStatistics& s) {
   const auto n = static_cast<Eigen::Index>(base.n_vertices());
-  s.mixed_areas.resize(n);
-  s.barycentric_areas.resize(n);
+  if (static_cast<Eigen::Index>(assembler.vertex_count()) != n)
+    throw InvalidArgument(fmt::format("update_vertex_figures: the assembler has {} vertices, the "
+                                      "base {}; pass the new base's assembler",
+                                      assembler.vertex_count(), n));
+  // The mixed areas and the rows of −W are the assembler's; the barycentric areas are carried
+  // over, then measured again around the new faces.
+  s.mixed_areas = assembler.areas();
+  const SparseMatrix& minus_w = assembler.minus_w();
   s.rows.resize(n);
-  for (Eigen::Index v = 0; v < statistics.rows.size(); ++v) {
+  parallel_for(static_cast<std::size_t>(n), 0, [&](std::size_t v) {
+    const auto c = static_cast<Eigen::Index>(v);
+    s.rows[c] = minus_w.col(c).squaredNorm();
+  });
+  s.barycentric_areas.resize(n);
+  for (Eigen::Index v = 0; v < statistics.barycentric_areas.size(); ++v) {
     const int to = change.vertex_map.empty() ? static_cast<int>(v)
                                              : change.vertex_map[static_cast<std::size_t>(v)];
-    if (to < 0) continue;
-    s.mixed_areas[to] = statistics.mixed_areas[v];
-    s.barycentric_areas[to] = statistics.barycentric_areas[v];
-    s.rows[to] = statistics.rows[v];
+    if (to >= 0) s.barycentric_areas[to] = statistics.barycentric_areas[v];
   }
   std::vector<char> done(base.n_vertices(), 0);
-  std::vector<VertexHandle> measure;
   for (const int f : change.new_faces)
-    for (const VertexHandle v : base.fv_range(FaceHandle(f)))
-      if (!done[static_cast<std::size_t>(v.idx())]) {
-        done[static_cast<std::size_t>(v.idx())] = 1;
-        measure.push_back(v);
-      }
-  parallel_for(measure.size(), 0,
-               [&](std::size_t i) { vertex_statistics(base, measure[i], s, measure[i].idx()); });
-  defect = symmetry_defect(base, s);
+    for (const VertexHandle v : base.fv_range(FaceHandle(f))) {
+      if (done[static_cast<std::size_t>(v.idx())]) continue;
+      done[static_cast<std::size_t>(v.idx())] = 1;
+      double barycentric = 0;
+      for (const FaceHandle g : base.vf_range(v)) barycentric += face_area(base, g) / 3.0;
+      s.barycentric_areas[v.idx()] = barycentric;
+    }
+  std::vector<VertexHandle> interior;
+  for (const VertexHandle v : base.vertices())
+    if (!base.is_isolated(v) && !base.is_boundary(v)) interior.push_back(v);
+  return {vertex_area_figures(s.mixed_areas, interior),
+          vertex_area_figures(s.barycentric_areas, interior), symmetry_defect(base, s)};
+}
 
+void update_mesh_figures(const Mesh& old, const MeshQuality& quality, const Mesh& base,
+                         const BaseChange& change, MeshQuality& q) {
   q = MeshQuality{};
   q.vertices = base.n_vertices();
   q.faces = base.n_faces();
@@ -182,10 +221,7 @@ void update_base_figures(const Mesh& old, const MeshQuality& quality,
   q.boundary_loops = quality.boundary_loops;
   q.components = quality.components;
   q.component_topology = quality.component_topology;
-  std::vector<VertexHandle> interior;
-  vertex_figures(base, q, interior);
-  q.mixed_area = vertex_area_figures(s.mixed_areas, interior);
-  q.barycentric_area = vertex_area_figures(s.barycentric_areas, interior);
+  update_valences(old, quality, base, change, q);
   q.bounding_box = bounding_box(base);
   q.bounding_box_diagonal = q.bounding_box.diagonal();
 

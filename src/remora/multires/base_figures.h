@@ -8,6 +8,7 @@
 #include <Eigen/Core>
 
 #include "remora/geometry/quality.h"
+#include "remora/linalg/kharmonic.h"
 #include "remora/mesh/mesh.h"
 
 namespace remora {
@@ -29,17 +30,31 @@ struct BaseChange {
   std::vector<int> vertex_map;
 };
 
-/// The figures of `base` (the new base) from those of `old` (the old base, with `quality`,
-/// `defect` and `statistics` its figures): the vertex statistics measured again on the vertices
-/// of the new faces, the per-face and per-edge sums of mesh_quality() updated by the old and new
-/// faces' terms, their extremes measured on the whole base only when the old extreme lay on an
-/// old face of the change. The topological figures (components, boundary loops) are kept, the
-/// counts are the new base's. Equal to mesh_quality(base) and laplacian_symmetry_defect(base)
-/// up to the order of summation.
-void update_base_figures(const Mesh& old, const MeshQuality& quality,
-                         const BaseStatistics& statistics, const Mesh& base,
-                         const BaseChange& change, MeshQuality& new_quality, double& new_defect,
-                         BaseStatistics& new_statistics);
+/// The figures of `base` (the new base) from those of `old` (the old base, `quality` its
+/// figures), all but those over the vertex statistics (mixed_area, barycentric_area): the
+/// vertex counts and valences less the old faces' vertices and plus the new faces', the per-face
+/// and per-edge sums of mesh_quality() updated by the old and new faces' terms, their extremes
+/// measured on the whole base only when the old extreme lay on an old face of the change. The
+/// topological figures (components, boundary loops) are kept, the counts are the new base's.
+/// Equal to mesh_quality(base) up to the order of summation.
+void update_mesh_figures(const Mesh& old, const MeshQuality& quality, const Mesh& base,
+                         const BaseChange& change, MeshQuality& new_quality);
+
+/// The figures of mesh_quality() and laplacian_symmetry_defect() over the vertex statistics.
+struct VertexFigures {
+  VertexAreaFigures mixed_area, barycentric_area;
+  double symmetry_defect = 0;
+};
+
+/// The vertex statistics of `base` and the figures over them: the mixed areas and the rows of −W
+/// are those of `assembler` (built for `base`, or carried over to it), the barycentric areas are
+/// carried over from `statistics` (the old base's) and measured again on the vertices of the new
+/// faces. Equal to base_statistics(base), mesh_quality(base) and laplacian_symmetry_defect(base)
+/// up to the order of summation. Throws InvalidArgument when the assembler is not of `base`'s
+/// size.
+VertexFigures update_vertex_figures(const BaseStatistics& statistics, const Mesh& base,
+                                    const BaseChange& change, const KHarmonicAssembler& assembler,
+                                    BaseStatistics& new_statistics);
 
 /// laplacian_symmetry_defect(base) from the statistics (all rows).
 double symmetry_defect(const Mesh& base, const BaseStatistics& statistics);
