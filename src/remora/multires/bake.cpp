@@ -209,6 +209,15 @@ void finish(Bake& b, const PatchMeshes* meshes, const RemeshPatchResult* remeshe
   b.report.milliseconds["assembler"] = assembler_ms;
 }
 
+// Step 3's splice and finish(). One named result, returned by every path: OpenMesh's meshes have
+// no move constructor, so a return that is not elided copies the input and the base.
+EditorParts stitch_and_finish(Bake& b, const PatchMeshes* meshes, const RemeshPatchResult* remeshed,
+                              SpliceMap& map) {
+  EditorParts parts = timed(b.report, "stitch", [&] { return stitch(b, meshes, remeshed, map); });
+  finish(b, meshes, remeshed, meshes ? &map : nullptr, parts);
+  return parts;
+}
+
 // Steps 1-3 of bake.h; throws NotLocal (or what a step throws) where they cannot work.
 EditorParts local_parts(const Editor& editor, const Eigen::MatrixXd& positions,
                         const BakeOptions& settings, BakeReport& report) {
@@ -223,11 +232,7 @@ EditorParts local_parts(const Editor& editor, const Eigen::MatrixXd& positions,
   progress(1);
   SpliceMap map;
   const bool has_patch = timed(report, "patch", [&] { return select_patch(b); });
-  if (!has_patch) {
-    EditorParts parts = timed(report, "stitch", [&] { return stitch(b, nullptr, nullptr, map); });
-    finish(b, nullptr, nullptr, nullptr, parts);
-    return parts;
-  }
+  if (!has_patch) return stitch_and_finish(b, nullptr, nullptr, map);
   const PatchMeshes meshes = timed(report, "patch", [&] { return patch_meshes(b); });
   progress(2);
   RemeshOptions ro = options.remesh_options;
@@ -241,9 +246,7 @@ EditorParts local_parts(const Editor& editor, const Eigen::MatrixXd& positions,
       timed(report, "remesh", [&] { return remesh_patch(meshes.reference, meshes.patch, ro); });
   report.patch_faces_after = remeshed.mesh.n_faces();
   progress(3);
-  EditorParts parts = timed(report, "stitch", [&] { return stitch(b, &meshes, &remeshed, map); });
-  finish(b, &meshes, &remeshed, &map, parts);
-  return parts;
+  return stitch_and_finish(b, &meshes, &remeshed, map);
 }
 
 } // namespace

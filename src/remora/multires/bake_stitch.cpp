@@ -18,11 +18,12 @@ Vec3 row_point(const Eigen::MatrixXd& p, Eigen::Index i) {
   return Vec3(p(i, 0), p(i, 1), p(i, 2));
 }
 
-// The base with the remeshed patch in place of the old one (splice(): the old base's numbering
-// kept outside the patch); its correspondence to the input.
-Mesh stitched_base(const Bake& b, const PatchMeshes& m, const RemeshPatchResult& r,
+// `base`: B' with the remeshed patch in place of the old one (splice(): the old base's numbering
+// kept outside the patch); its correspondence to the input. An output argument: OpenMesh's
+// meshes have no move assignment, so a returned mesh would be copied into place.
+void stitched_base(const Bake& b, const PatchMeshes& m, const RemeshPatchResult& r, Mesh& base,
                    std::vector<SurfacePoint>& base_on_input, SpliceMap& map) {
-  Mesh base = b.old.base;
+  base = b.old.base;
   for (std::size_t v = 0; v < b.moved.size(); ++v)
     if (b.moved[v])
       base.set_point(VertexHandle(static_cast<int>(v)),
@@ -41,7 +42,6 @@ Mesh stitched_base(const Bake& b, const PatchMeshes& m, const RemeshPatchResult&
     base_on_input[static_cast<std::size_t>(map.patch_vertices[o])] = {
         FaceHandle(m.reference_faces[static_cast<std::size_t>(sp.face.idx())]), sp.bary};
   }
-  return base;
 }
 
 // Each input vertex's location on the new base: the remesh's closest point for those it
@@ -183,7 +183,7 @@ EditorParts stitch(const Bake& b, const PatchMeshes* m, const RemeshPatchResult*
                    SpliceMap& map) {
   EditorParts parts;
   if (m) {
-    parts.base = stitched_base(b, *m, *r, parts.base_on_input, map);
+    stitched_base(b, *m, *r, parts.base, parts.base_on_input, map);
   } else {
     parts.base = b.old.base;
     for (std::size_t v = 0; v < b.moved.size(); ++v)
