@@ -209,18 +209,17 @@ void finish(Bake& b, const PatchMeshes* meshes, const RemeshPatchResult* remeshe
   b.report.milliseconds["assembler"] = assembler_ms;
 }
 
-// Step 3's splice and finish(). One named result, returned by every path: OpenMesh's meshes have
-// no move constructor, so a return that is not elided copies the input and the base.
-EditorParts stitch_and_finish(Bake& b, const PatchMeshes* meshes, const RemeshPatchResult* remeshed,
-                              SpliceMap& map) {
-  EditorParts parts = timed(b.report, "stitch", [&] { return stitch(b, meshes, remeshed, map); });
+// Step 3's splice and finish().
+void stitch_and_finish(Bake& b, const PatchMeshes* meshes, const RemeshPatchResult* remeshed,
+                       SpliceMap& map, EditorParts& parts) {
+  timed(b.report, "stitch", [&] { stitch(b, meshes, remeshed, map, parts); });
   finish(b, meshes, remeshed, meshes ? &map : nullptr, parts);
-  return parts;
 }
 
-// Steps 1-3 of bake.h; throws NotLocal (or what a step throws) where they cannot work.
-EditorParts local_parts(const Editor& editor, const Eigen::MatrixXd& positions,
-                        const BakeOptions& settings, BakeReport& report) {
+// Steps 1-3 of bake.h into `parts` (an empty EditorParts, where the new editor keeps it); throws
+// NotLocal (or what a step throws) where they cannot work.
+void local_parts(const Editor& editor, const Eigen::MatrixXd& positions,
+                 const BakeOptions& settings, BakeReport& report, EditorParts& parts) {
   const EditorOptions& options = editor.options();
   Bake b{editor.parts(), options, settings, report, positions, {}, {}, {}, {}, {}};
   auto progress = [&](int step) {
@@ -232,7 +231,10 @@ EditorParts local_parts(const Editor& editor, const Eigen::MatrixXd& positions,
   progress(1);
   SpliceMap map;
   const bool has_patch = timed(report, "patch", [&] { return select_patch(b); });
-  if (!has_patch) return stitch_and_finish(b, nullptr, nullptr, map);
+  if (!has_patch) {
+    stitch_and_finish(b, nullptr, nullptr, map, parts);
+    return;
+  }
   const PatchMeshes meshes = timed(report, "patch", [&] { return patch_meshes(b); });
   progress(2);
   RemeshOptions ro = options.remesh_options;
@@ -246,7 +248,7 @@ EditorParts local_parts(const Editor& editor, const Eigen::MatrixXd& positions,
       timed(report, "remesh", [&] { return remesh_patch(meshes.reference, meshes.patch, ro); });
   report.patch_faces_after = remeshed.mesh.n_faces();
   progress(3);
-  return stitch_and_finish(b, &meshes, &remeshed, map);
+  stitch_and_finish(b, &meshes, &remeshed, map, parts);
 }
 
 } // namespace
@@ -266,10 +268,14 @@ BakeResult bake(Editor& editor, const BakeOptions& options) {
   if (reason.empty()) {
     try {
       const double cpu0 = bake_detail::cpu_ms();
-      EditorParts parts = bake_detail::local_parts(editor, positions, options, report);
-      const auto t_editor = Clock::now();
-      Editor baked(std::move(parts), editor.options());
-      report.milliseconds["editor"] = ms_since(t_editor);
+      Clock::time_point built;
+      Editor baked(
+          [&](EditorParts& parts) {
+            bake_detail::local_parts(editor, positions, options, report, parts);
+            built = Clock::now();
+          },
+          editor.options());
+      report.milliseconds["editor"] = ms_since(built);
       report.cpu_milliseconds["total"] = bake_detail::cpu_ms() - cpu0;
       report.local = true;
       report.milliseconds["total"] = ms_since(t0);

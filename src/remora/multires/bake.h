@@ -14,9 +14,9 @@
 //      spliced back (mesh/splice.h). Both correspondences are carried over and mended where the
 //      base moved; the report's base figures are updated where the base changed.
 //   4. The new editor adopts O', S', the filter (O's, shared: the metric stays the one the
-//      editor was built with), the base and the correspondences (Editor(EditorParts, ...)), and
-//      the old editor's Laplacian assembler (linalg/kharmonic.h) and base normals updated where
-//      the base changed.
+//      editor was built with), the base and the correspondences, built in place
+//      (Editor(build, options)), and the old editor's Laplacian assembler (linalg/kharmonic.h)
+//      and base normals updated where the base changed.
 //
 // Where the local bake cannot work (no remeshed base, feature lines, a band or patch covering
 // most of the mesh, a patch without border, a failure on the way), bake() preprocesses O' in

@@ -55,11 +55,12 @@ bool select_patch(Bake& b);
 /// The patch and its reference as meshes (bake_patch.cpp). Throws NotLocal when a part of the
 /// patch has no border.
 PatchMeshes patch_meshes(const Bake& b);
-/// The new editor's base: `remeshed` spliced in place of the patch (`map` says where its elements
-/// went), or B' alone when there is none (`meshes` and `remeshed` null); with its correspondence
-/// to the input. The other parts are left to carry_input() and mend().
-EditorParts stitch(const Bake& b, const PatchMeshes* meshes, const RemeshPatchResult* remeshed,
-                   SpliceMap& map);
+/// The new editor's base into `parts` (an empty EditorParts): `remeshed` spliced in place of the
+/// patch (`map` says where its elements went), or B' alone when there is none (`meshes` and
+/// `remeshed` null); with its correspondence to the input. The other parts are left to
+/// carry_input() and mend().
+void stitch(const Bake& b, const PatchMeshes* meshes, const RemeshPatchResult* remeshed,
+            SpliceMap& map, EditorParts& parts);
 /// The new editor's input, its topology and filter: the old ones, with O' in the band. Touches no
 /// part that stitch() or mend() writes.
 void carry_input(const Bake& b, EditorParts& parts);

@@ -179,9 +179,8 @@ void base_figures(const Bake& b, const BaseChange& change, EditorParts& parts,
   }
 }
 
-EditorParts stitch(const Bake& b, const PatchMeshes* m, const RemeshPatchResult* r,
-                   SpliceMap& map) {
-  EditorParts parts;
+void stitch(const Bake& b, const PatchMeshes* m, const RemeshPatchResult* r, SpliceMap& map,
+            EditorParts& parts) {
   if (m) {
     stitched_base(b, *m, *r, parts.base, parts.base_on_input, map);
   } else {
@@ -192,7 +191,6 @@ EditorParts stitch(const Bake& b, const PatchMeshes* m, const RemeshPatchResult*
                              row_point(b.base_points, static_cast<Eigen::Index>(v)));
     parts.base_on_input = b.old.base_on_input;
   }
-  return parts;
 }
 
 void carry_input(const Bake& b, EditorParts& parts) {

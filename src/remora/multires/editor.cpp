@@ -153,39 +153,23 @@ Editor::Editor(Mesh mesh, EditorOptions options) : impl_(std::make_unique<Impl>(
   m.report.milliseconds["base report"] = ms_since(t0);
 }
 
-Editor::Editor(EditorParts&& parts, EditorOptions options) : impl_(std::make_unique<Impl>()) {
+Editor::Editor(const std::function<void(EditorParts&)>& build, EditorOptions options)
+    : impl_(std::make_unique<Impl>()) {
   Impl& m = *impl_;
   check_options(options);
-  const auto ni = static_cast<Eigen::Index>(parts.input.n_vertices());
-  const auto nb = static_cast<Eigen::Index>(parts.base.n_vertices());
-  if (!options.remesh || !parts.filter || parts.input_positions.rows() != ni ||
-      parts.smooth.rows() != ni || parts.input_on_base.size() != std::size_t(ni) ||
-      parts.base_rest.rows() != nb || parts.base_on_input.size() != std::size_t(nb) ||
-      parts.topology.faces.size() != parts.base.n_faces() ||
-      parts.input_topology.faces.size() != parts.input.n_faces())
+  m.options = std::move(options);
+  build(m);
+  const auto ni = static_cast<Eigen::Index>(m.input.n_vertices());
+  const auto nb = static_cast<Eigen::Index>(m.base.n_vertices());
+  if (!m.options.remesh || !m.filter || m.input_positions.rows() != ni || m.smooth.rows() != ni ||
+      m.input_on_base.size() != std::size_t(ni) || m.base_rest.rows() != nb ||
+      m.base_on_input.size() != std::size_t(nb) || m.topology.faces.size() != m.base.n_faces() ||
+      m.input_topology.faces.size() != m.input.n_faces())
     throw InvalidArgument("editor parts: the sizes of the input, the base and their "
                           "correspondences disagree (or remesh is off)");
-  m.options = std::move(options);
-  m.input = std::move(parts.input);
-  m.input_positions = std::move(parts.input_positions);
-  m.input_topology = std::move(parts.input_topology);
-  m.filter = std::move(parts.filter);
-  m.smooth = std::move(parts.smooth);
-  m.base = std::move(parts.base);
-  m.topology = std::move(parts.topology);
-  m.base_rest = std::move(parts.base_rest);
-  m.base_on_input = std::move(parts.base_on_input);
-  m.input_on_base = std::move(parts.input_on_base);
-  m.negative_edges = std::move(parts.negative_edges);
-  m.statistics = std::move(parts.statistics);
-  m.report = std::move(parts.report);
-  if (parts.base_normals.rows() == nb && parts.base_normals.cols() == 3)
-    m.base_normals = std::move(parts.base_normals);
-  else
+  if (m.base_normals.rows() != nb || m.base_normals.cols() != 3)
     m.base_normals = vertex_normals(m.topology, m.base_rest);
-  if (parts.assembler && parts.assembler->vertex_count() == m.base.n_vertices())
-    m.assembler = std::move(parts.assembler);
-  else
+  if (!m.assembler || m.assembler->vertex_count() != m.base.n_vertices())
     m.assembler.emplace(m.base, m.options.threads);
 }
 

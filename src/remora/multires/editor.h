@@ -202,10 +202,12 @@ public:
   /// Steps 1-3. `mesh` must be a repaired mesh without deleted elements (read_mesh() gives one).
   /// Throws InvalidArgument for an empty mesh, non-finite points or bad options.
   explicit Editor(Mesh mesh, EditorOptions options = {});
-  /// Steps 1-3 adopted from a bake (multires/bake.h): nothing recomputed but the base's normals
-  /// and its Laplacian assembler where `parts` has none for this base; `options` as they made the
-  /// pieces, remesh on. Throws InvalidArgument when the pieces' sizes disagree.
-  Editor(EditorParts&& parts, EditorOptions options);
+  /// Steps 1-3 adopted from a bake (multires/bake.h): `build` fills the parts in place, where the
+  /// editor keeps them (OpenMesh's meshes cannot be moved, only copied); nothing is recomputed
+  /// but the base's normals and its Laplacian assembler where the parts have none for this base.
+  /// `options` as they made the pieces, remesh on. Throws what `build` throws, and
+  /// InvalidArgument when the pieces' sizes disagree.
+  Editor(const std::function<void(EditorParts&)>& build, EditorOptions options);
   Editor(Editor&&) noexcept;
   Editor& operator=(Editor&&) noexcept;
   ~Editor();

@@ -56,24 +56,12 @@ struct Editor::Prepared::State {
 
 using RegionState = Editor::Prepared::State;
 
-struct Editor::Impl {
+// The preprocessed pieces are the base class, so that a bake builds them where the editor keeps
+// them (Editor(build, options)): OpenMesh's meshes cannot be moved, only copied.
+struct Editor::Impl : EditorParts {
   EditorOptions options;
-  Mesh input;
-  Eigen::MatrixXd input_positions;
-  TriangleTopology input_topology;
-  std::shared_ptr<const LowPassFilter> filter; // immutable: editors made by a bake share it
-  Eigen::MatrixXd smooth;                      // S = filter(O)
-  Mesh base;
-  TriangleTopology topology;
-  Eigen::MatrixXd base_rest;    // B
-  Eigen::MatrixXd base_normals; // of B
-  std::vector<SurfacePoint> base_on_input, input_on_base;
-  std::vector<std::pair<int, int>> negative_edges; // of B
-  std::optional<KHarmonicAssembler> assembler;     // B's systems
-  BaseStatistics statistics;                       // of B: what a bake updates the report from
   std::unique_ptr<MultigridSolver> multigrid;
   std::shared_ptr<const RemeshResult> coarse; // method nonlinear's preview level, for every region
-  EditReport report;
   std::unique_ptr<RegionState> region;
   // The regions installed before the current one, the latest first: set_region() of one of them
   // again (an undo) installs it as it was, without the work.
