@@ -199,6 +199,12 @@ TEST(Bake, MatchesAFullPreprocessAndKeepsTheRestBitForBit) {
     // The base's normals, carried over where no face around them changed: vertex_normals()'s bits.
     const EditorPartsView lp = local.editor.parts();
     EXPECT_EQ(lp.base_normals, vertex_normals(lp.topology, lp.base_rest));
+    // The base's topology, carried over through the splice: the base's own.
+    const TriangleTopology fresh_topology = triangle_topology(lp.base);
+    EXPECT_EQ(lp.topology.faces, fresh_topology.faces);
+    EXPECT_EQ(lp.topology.across, fresh_topology.across);
+    EXPECT_EQ(lp.topology.vertex_offsets, fresh_topology.vertex_offsets);
+    EXPECT_EQ(lp.topology.vertex_faces, fresh_topology.vertex_faces);
     // The Laplacian assembler, carried over from the old editor where the base did not change,
     // is the new base's: −W to round-off in the diagonal, the same systems.
     const KHarmonicAssembler fresh(local.editor.base());

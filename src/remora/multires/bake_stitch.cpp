@@ -82,6 +82,35 @@ std::vector<SurfacePoint> mend_input_on_base(const Bake& b, const Mesh& base, co
   return out;
 }
 
+// The new base's TriangleTopology, as triangle_topology() reads it: the old faces renumbered
+// through the splice (which keeps a kept face's halfedge, so its corners' order), the patch's
+// faces and the kept faces across from a removed one read from the mesh, the vertex-face lists
+// rebuilt.
+TriangleTopology carried_topology(const Bake& b, const Mesh& base, const SpliceMap& map) {
+  TriangleTopology t;
+  const std::size_t nf = base.n_faces();
+  t.faces.resize(nf);
+  t.across.resize(nf);
+  std::vector<char> read(nf, 0);
+  for (const int f : map.patch_faces) read[static_cast<std::size_t>(f)] = 1;
+  const TriangleTopology& old = b.old.topology;
+  for (std::size_t f = 0; f < old.faces.size(); ++f) {
+    const int to = map.faces[f];
+    if (to < 0) continue;
+    const auto i = static_cast<std::size_t>(to);
+    for (std::size_t k = 0; k < 3; ++k) {
+      t.faces[i][k] = map.vertices[static_cast<std::size_t>(old.faces[f][k])];
+      const int g = old.across[f][k];
+      t.across[i][k] = g < 0 ? -1 : map.faces[static_cast<std::size_t>(g)];
+      if (g >= 0 && t.across[i][k] < 0) read[i] = 1;
+    }
+  }
+  for (std::size_t f = 0; f < nf; ++f)
+    if (read[f]) read_face_topology(base, f, t);
+  build_vertex_faces(t, base.n_vertices());
+  return t;
+}
+
 // What the bake changed in the base (base_figures.h): the patch's faces, old and new, and the
 // kept faces with a moved corner.
 } // namespace
@@ -208,7 +237,7 @@ void mend(Bake& b, const PatchMeshes* m, const RemeshPatchResult* r, const Splic
   parts.input_on_base = mend_input_on_base(b, parts.base, m, r, map);
   parts.input_positions = b.input_positions;
   parts.smooth = std::move(b.smooth);
-  parts.topology = m ? triangle_topology(parts.base) : b.old.topology;
+  parts.topology = map ? carried_topology(b, parts.base, *map) : b.old.topology;
   parts.base_rest = positions_matrix(parts.base);
 }
 

@@ -233,40 +233,44 @@ Outcome encode_one(const TriangleTopology& t, const Eigen::MatrixXd& positions,
 
 } // namespace
 
-TriangleTopology triangle_topology(const Mesh& mesh) {
-  TriangleTopology t;
-  const std::size_t nf = mesh.n_faces();
-  t.faces.resize(nf);
-  t.across.resize(nf);
-  for (std::size_t i = 0; i < nf; ++i) {
-    const FaceHandle f(static_cast<int>(i));
-    if (mesh.status(f).deleted())
-      throw InvalidArgument("triangle_topology: the mesh has deleted faces; call "
-                            "garbage_collection() first");
-    HalfedgeHandle h = mesh.halfedge_handle(f);
-    // Corner k = from(h0), to(h0), to(next(h0)); the edge opposite corner 0 is next(h0), opposite
-    // corner 1 is next(next(h0)), opposite corner 2 is h0.
-    const HalfedgeHandle h0 = h, h1 = mesh.next_halfedge_handle(h0),
-                         h2 = mesh.next_halfedge_handle(h1);
-    t.faces[i] = {mesh.from_vertex_handle(h0).idx(), mesh.to_vertex_handle(h0).idx(),
-                  mesh.to_vertex_handle(h1).idx()};
-    const HalfedgeHandle opposite[3] = {h1, h2, h0};
-    for (int k = 0; k < 3; ++k) {
-      const FaceHandle g = mesh.face_handle(mesh.opposite_halfedge_handle(opposite[k]));
-      t.across[i][static_cast<std::size_t>(k)] = g.is_valid() ? g.idx() : -1;
-    }
+void read_face_topology(const Mesh& mesh, std::size_t i, TriangleTopology& t) {
+  const FaceHandle f(static_cast<int>(i));
+  if (mesh.status(f).deleted())
+    throw InvalidArgument("triangle_topology: the mesh has deleted faces; call "
+                          "garbage_collection() first");
+  // Corner k = from(h0), to(h0), to(next(h0)); the edge opposite corner 0 is next(h0), opposite
+  // corner 1 is next(next(h0)), opposite corner 2 is h0.
+  const HalfedgeHandle h0 = mesh.halfedge_handle(f), h1 = mesh.next_halfedge_handle(h0),
+                       h2 = mesh.next_halfedge_handle(h1);
+  t.faces[i] = {mesh.from_vertex_handle(h0).idx(), mesh.to_vertex_handle(h0).idx(),
+                mesh.to_vertex_handle(h1).idx()};
+  const HalfedgeHandle opposite[3] = {h1, h2, h0};
+  for (int k = 0; k < 3; ++k) {
+    const FaceHandle g = mesh.face_handle(mesh.opposite_halfedge_handle(opposite[k]));
+    t.across[i][static_cast<std::size_t>(k)] = g.is_valid() ? g.idx() : -1;
   }
-  const std::size_t nv = mesh.n_vertices();
+}
+
+void build_vertex_faces(TriangleTopology& t, std::size_t nv) {
   t.vertex_offsets.assign(nv + 1, 0);
   for (const auto& f : t.faces)
     for (int v : f) ++t.vertex_offsets[static_cast<std::size_t>(v) + 1];
   for (std::size_t v = 0; v < nv; ++v) t.vertex_offsets[v + 1] += t.vertex_offsets[v];
   t.vertex_faces.resize(static_cast<std::size_t>(t.vertex_offsets[nv]));
   std::vector<int> fill(t.vertex_offsets.begin(), t.vertex_offsets.end() - 1);
-  for (std::size_t i = 0; i < nf; ++i)
+  for (std::size_t i = 0; i < t.faces.size(); ++i)
     for (int v : t.faces[i])
       t.vertex_faces[static_cast<std::size_t>(fill[static_cast<std::size_t>(v)]++)] =
           static_cast<int>(i);
+}
+
+TriangleTopology triangle_topology(const Mesh& mesh) {
+  TriangleTopology t;
+  const std::size_t nf = mesh.n_faces();
+  t.faces.resize(nf);
+  t.across.resize(nf);
+  for (std::size_t i = 0; i < nf; ++i) read_face_topology(mesh, i, t);
+  build_vertex_faces(t, mesh.n_vertices());
   return t;
 }
 

@@ -40,6 +40,12 @@ struct TriangleTopology {
 
 /// Throws InvalidArgument if `mesh` has deleted faces (garbage-collect first).
 TriangleTopology triangle_topology(const Mesh& mesh);
+/// Face i's corners and the faces across its edges, read from `mesh` into t.faces[i] and
+/// t.across[i] (sized by the caller), as triangle_topology() reads them. Throws InvalidArgument
+/// if face i is deleted.
+void read_face_topology(const Mesh& mesh, std::size_t i, TriangleTopology& t);
+/// t.vertex_offsets and t.vertex_faces for `vertices` vertices, from t.faces.
+void build_vertex_faces(TriangleTopology& t, std::size_t vertices);
 
 /// Unit vertex normals (n_vertices × 3): the sum of the incident faces' cross products (area
 /// weighted), normalized; (0, 0, 0) for a vertex whose faces all have zero area.
