@@ -262,6 +262,52 @@ TEST(Bake, MatchesAFullPreprocessAndKeepsTheRestBitForBit) {
   }
 }
 
+TEST(Bake, TheReportFollowsTheBaseThroughBakesOfBakesAtABoundary) {
+  // Three bakes in a row, each of the last one's editor, around a hole of the bunny, on one
+  // thread: the valences and counts updated where faces changed are the base's own, boundary
+  // ones included, and so are the figures over the statistics.
+  Mesh bunny = read_mesh(std::string(REMORA_REPO_DATA) + "/bunny.ply").mesh;
+  VertexHandle rim;
+  for (const VertexHandle v : bunny.vertices())
+    if (bunny.is_boundary(v)) {
+      rim = v;
+      break;
+    }
+  ASSERT_TRUE(rim.is_valid());
+  EditorOptions options;
+  options.threads = 1;
+  std::vector<BakeResult> bakes;
+  bakes.reserve(3);
+  Editor first(bunny, options);
+  Editor* editor = &first;
+  for (int round = 0; round < 3; ++round) {
+    SCOPED_TRACE(round);
+    const BakeRegion r = region(editor->input(), rim, 2500);
+    editor->set_region(r.support, {r.handle});
+    editor->set_transform(0, translation({0.0, round % 2 ? -0.004 : 0.004, 0.003}));
+    bakes.push_back(bake(*editor));
+    const BakeResult& b = bakes.back();
+    ASSERT_TRUE(b.report.local) << b.report.fallback;
+    const MeshQuality& qr = b.editor.report().base_quality;
+    const MeshQuality q = mesh_quality(b.editor.base());
+    EXPECT_GT(q.boundary_vertices, 0u);
+    EXPECT_EQ(qr.valence.interior, q.valence.interior);
+    EXPECT_EQ(qr.valence.boundary, q.valence.boundary);
+    EXPECT_EQ(qr.interior_vertices, q.interior_vertices);
+    EXPECT_EQ(qr.boundary_vertices, q.boundary_vertices);
+    EXPECT_EQ(qr.isolated_vertices, q.isolated_vertices);
+    EXPECT_EQ(qr.valence.percent_boundary_4, q.valence.percent_boundary_4);
+    const auto near = [](double a, double c) {
+      return std::abs(a - c) <= 1e-9 * std::max(1.0, std::abs(c));
+    };
+    EXPECT_TRUE(near(qr.mixed_area.rel_mad, q.mixed_area.rel_mad));
+    EXPECT_TRUE(near(qr.barycentric_area.rel_mad, q.barycentric_area.rel_mad));
+    EXPECT_TRUE(
+        near(b.editor.report().base_symmetry_defect, laplacian_symmetry_defect(b.editor.base())));
+    editor = &bakes.back().editor;
+  }
+}
+
 TEST(Bake, FallsBackToTheFullPreprocessWithAReason) {
   const Mesh mesh = bumpy_fine_sphere();
   Editor editor(mesh, two_threads());

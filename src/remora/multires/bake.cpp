@@ -183,7 +183,9 @@ auto timed(BakeReport& report, const char* part, F&& f) {
 // the new base, then the base's vertex statistics and the figures over them from it; it reads the
 // old editor, the new base and the map, and writes parts.assembler and parts.statistics. The
 // first copies the input, mends the correspondence and updates the other figures and the
-// normals. "assembler" is the second thread's wall time, "wait" the first's wait for it.
+// normals. "assembler" is the second thread's wall time, "wait" the first's wait for it (with one
+// thread the second's work runs inside "wait"). Should the first thread throw, the future's
+// destructor waits for the job, which reads only what outlives it.
 void finish(Bake& b, const PatchMeshes* meshes, const RemeshPatchResult* remeshed,
             const SpliceMap* map, EditorParts& parts) {
   const BaseChange change = timed(b.report, "report", [&] { return base_change(b, map); });
@@ -193,7 +195,7 @@ void finish(Bake& b, const PatchMeshes* meshes, const RemeshPatchResult* remeshe
     const auto t0 = Clock::now();
     update_assembler(b, map, parts);
     figures = update_vertex_figures(b.old.statistics, parts.base, change, *parts.assembler,
-                                    parts.statistics);
+                                    parts.statistics, b.options.threads);
     assembler_ms = ms_since(t0);
   });
   timed(b.report, "mend", [&] {

@@ -65,8 +65,9 @@ struct BakeReport {
   /// splice), then on one thread "mend" (the input copied and located on the new base), "report"
   /// (the base's figures), "normals" (the base's normals, updated where it changed) and "wait"
   /// (for the second thread), while the second builds the "assembler" (the old editor's
-  /// Laplacian assembler updated where the base changed); "editor" (the new editor's
-  /// construction), "total"; only "total" for the full preprocess.
+  /// Laplacian assembler updated where the base changed, then the figures over the vertex
+  /// statistics; with threads = 1 it runs inside "wait"); "editor" (the new editor's checks
+  /// after its parts are built in place), "total"; only "total" for the full preprocess.
   std::map<std::string, double> milliseconds;
   /// The process's CPU time (all threads) in the same parts: on a busy machine the wall time
   /// says little about a part's own work.

@@ -65,7 +65,8 @@ void stitch(const Bake& b, const PatchMeshes* meshes, const RemeshPatchResult* r
 /// part that stitch() or mend() writes.
 void carry_input(const Bake& b, EditorParts& parts);
 /// The new editor's input on the base (each input vertex located again where the base or S' moved
-/// under it), O', S' (moved out of b), the base's topology and rest positions. Throws NotLocal
+/// under it), O', S' (both moved out of b: call it after carry_input()), the base's topology and
+/// rest positions. Throws NotLocal
 /// when the correspondence cannot be carried over. `map` is null without a patch.
 void mend(Bake& b, const PatchMeshes* meshes, const RemeshPatchResult* remeshed,
           const SpliceMap* map, EditorParts& parts);

@@ -111,8 +111,6 @@ TriangleTopology carried_topology(const Bake& b, const Mesh& base, const SpliceM
   return t;
 }
 
-// What the bake changed in the base (base_figures.h): the patch's faces, old and new, and the
-// kept faces with a moved corner.
 } // namespace
 
 BaseChange base_change(const Bake& b, const SpliceMap* map) {
@@ -235,7 +233,7 @@ void carry_input(const Bake& b, EditorParts& parts) {
 void mend(Bake& b, const PatchMeshes* m, const RemeshPatchResult* r, const SpliceMap* map,
           EditorParts& parts) {
   parts.input_on_base = mend_input_on_base(b, parts.base, m, r, map);
-  parts.input_positions = b.input_positions;
+  parts.input_positions = std::move(b.input_positions); // carry_input() has read it
   parts.smooth = std::move(b.smooth);
   parts.topology = map ? carried_topology(b, parts.base, *map) : b.old.topology;
   parts.base_rest = positions_matrix(parts.base);

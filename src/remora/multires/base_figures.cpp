@@ -175,7 +175,7 @@ double symmetry_defect(const Mesh& base, const BaseStatistics& s) {
 
 VertexFigures update_vertex_figures(const BaseStatistics& statistics, const Mesh& base,
                                     const BaseChange& change, const KHarmonicAssembler& assembler,
-                                    BaseStatistics& s) {
+                                    BaseStatistics& s, int threads) {
   const auto n = static_cast<Eigen::Index>(base.n_vertices());
   if (static_cast<Eigen::Index>(assembler.vertex_count()) != n)
     throw InvalidArgument(fmt::format("update_vertex_figures: the assembler has {} vertices, the "
@@ -186,7 +186,7 @@ VertexFigures update_vertex_figures(const BaseStatistics& statistics, const Mesh
   s.mixed_areas = assembler.areas();
   const SparseMatrix& minus_w = assembler.minus_w();
   s.rows.resize(n);
-  parallel_for(static_cast<std::size_t>(n), 0, [&](std::size_t v) {
+  parallel_for(static_cast<std::size_t>(n), threads, [&](std::size_t v) {
     const auto c = static_cast<Eigen::Index>(v);
     s.rows[c] = minus_w.col(c).squaredNorm();
   });

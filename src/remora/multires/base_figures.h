@@ -50,11 +50,11 @@ struct VertexFigures {
 /// are those of `assembler` (built for `base`, or carried over to it), the barycentric areas are
 /// carried over from `statistics` (the old base's) and measured again on the vertices of the new
 /// faces. Equal to base_statistics(base), mesh_quality(base) and laplacian_symmetry_defect(base)
-/// up to the order of summation. Throws InvalidArgument when the assembler is not of `base`'s
-/// size.
+/// up to the order of summation. `threads`: 0 = all. Throws InvalidArgument when the assembler
+/// is not of `base`'s size.
 VertexFigures update_vertex_figures(const BaseStatistics& statistics, const Mesh& base,
                                     const BaseChange& change, const KHarmonicAssembler& assembler,
-                                    BaseStatistics& new_statistics);
+                                    BaseStatistics& new_statistics, int threads = 0);
 
 /// laplacian_symmetry_defect(base) from the statistics (all rows).
 double symmetry_defect(const Mesh& base, const BaseStatistics& statistics);

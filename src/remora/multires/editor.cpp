@@ -169,6 +169,9 @@ Editor::Editor(const std::function<void(EditorParts&)>& build, EditorOptions opt
                           "correspondences disagree (or remesh is off)");
   if (m.base_normals.rows() != nb || m.base_normals.cols() != 3)
     m.base_normals = vertex_normals(m.topology, m.base_rest);
+  if (m.statistics.mixed_areas.size() != nb || m.statistics.barycentric_areas.size() != nb ||
+      m.statistics.rows.size() != nb)
+    m.statistics = base_statistics(m.base);
   if (!m.assembler || m.assembler->vertex_count() != m.base.n_vertices())
     m.assembler.emplace(m.base, m.options.threads);
 }

@@ -204,7 +204,8 @@ public:
   explicit Editor(Mesh mesh, EditorOptions options = {});
   /// Steps 1-3 adopted from a bake (multires/bake.h): `build` fills the parts in place, where the
   /// editor keeps them (OpenMesh's meshes cannot be moved, only copied); nothing is recomputed
-  /// but the base's normals and its Laplacian assembler where the parts have none for this base.
+  /// but the base's normals, statistics and Laplacian assembler where the parts have none for
+  /// this base.
   /// `options` as they made the pieces, remesh on. Throws what `build` throws, and
   /// InvalidArgument when the pieces' sizes disagree.
   Editor(const std::function<void(EditorParts&)>& build, EditorOptions options);
