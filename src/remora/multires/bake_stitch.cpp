@@ -18,16 +18,22 @@ Vec3 row_point(const Eigen::MatrixXd& p, Eigen::Index i) {
   return Vec3(p(i, 0), p(i, 1), p(i, 2));
 }
 
+// `to`: a copy of `from` with vertex v at row v of `points` wherever `flags[v]` is set.
+void copy_moved(const Mesh& from, const std::vector<char>& flags, const Eigen::MatrixXd& points,
+                Mesh& to) {
+  to = from;
+  for (std::size_t v = 0; v < flags.size(); ++v)
+    if (flags[v])
+      to.set_point(VertexHandle(static_cast<int>(v)),
+                   row_point(points, static_cast<Eigen::Index>(v)));
+}
+
 // `base`: B' with the remeshed patch in place of the old one (splice(): the old base's numbering
 // kept outside the patch); its correspondence to the input. An output argument: OpenMesh's
 // meshes have no move assignment, so a returned mesh would be copied into place.
 void stitched_base(const Bake& b, const PatchMeshes& m, const RemeshPatchResult& r, Mesh& base,
                    std::vector<SurfacePoint>& base_on_input, SpliceMap& map) {
-  base = b.old.base;
-  for (std::size_t v = 0; v < b.moved.size(); ++v)
-    if (b.moved[v])
-      base.set_point(VertexHandle(static_cast<int>(v)),
-                     row_point(b.base_points, static_cast<Eigen::Index>(v)));
+  copy_moved(b.old.base, b.moved, b.base_points, base);
   std::vector<int> origin(r.origin.size(), -1);
   for (std::size_t o = 0; o < origin.size(); ++o)
     if (r.origin[o] >= 0) origin[o] = m.patch_vertices[static_cast<std::size_t>(r.origin[o])];
@@ -211,21 +217,13 @@ void stitch(const Bake& b, const PatchMeshes* m, const RemeshPatchResult* r, Spl
   if (m) {
     stitched_base(b, *m, *r, parts.base, parts.base_on_input, map);
   } else {
-    parts.base = b.old.base;
-    for (std::size_t v = 0; v < b.moved.size(); ++v)
-      if (b.moved[v])
-        parts.base.set_point(VertexHandle(static_cast<int>(v)),
-                             row_point(b.base_points, static_cast<Eigen::Index>(v)));
+    copy_moved(b.old.base, b.moved, b.base_points, parts.base);
     parts.base_on_input = b.old.base_on_input;
   }
 }
 
 void carry_input(const Bake& b, EditorParts& parts) {
-  parts.input = b.old.input;
-  for (std::size_t i = 0; i < b.in_band.size(); ++i)
-    if (b.in_band[i])
-      parts.input.set_point(VertexHandle(static_cast<int>(i)),
-                            row_point(b.input_positions, static_cast<Eigen::Index>(i)));
+  copy_moved(b.old.input, b.in_band, b.input_positions, parts.input);
   parts.input_topology = b.old.input_topology;
   parts.filter = b.old.filter;
 }
