@@ -409,11 +409,12 @@ void Editor::install_region(Prepared&& prepared) {
   if (!prepared.state_ || prepared.state_->owner != impl_.get())
     throw InvalidArgument("install_region: the region was not prepared by this editor (or was "
                           "installed already)");
-  // The report's region figures and set_region's times; the rest stays the editor's.
+  // The report's region figures and set_region's times; the rest stays the editor's. A copy: the
+  // region keeps its own for when it is set again from the recent ones.
   EditReport& r = prepared.state_->report;
   for (const auto& [key, ms] : impl_->report.milliseconds)
     if (key.rfind("frame", 0) == 0) r.milliseconds[key] = ms;
-  impl_->report = std::move(r);
+  impl_->report = r;
   if (impl_->region) {
     impl_->recent.push_front(std::move(impl_->region));
     if (impl_->recent.size() > Impl::kRecentRegions) impl_->recent.pop_back();
