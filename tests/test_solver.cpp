@@ -3,11 +3,15 @@
 // reverse Cuthill-McKee shrinks the band of a scrambled grid.
 #include <gtest/gtest.h>
 
+#include <dlfcn.h>
+
 #include <algorithm>
 #include <numeric>
 #include <random>
+#include <thread>
 
 #include "remora/common/error.h"
+#include "remora/linalg/blas_threads.h"
 #include "remora/linalg/kharmonic.h"
 #include "remora/linalg/solver.h"
 #include "remora/mesh/primitives.h"
@@ -61,6 +65,34 @@ TEST(Solver, EverySolverAgreesWithTheDirectOneOnTheSymmetricSystem) {
       EXPECT_LE(relative_difference(solver->solve(b), x), 1e-8);
     }
   }
+}
+
+TEST(Solver, BlasThreadsScopeHoldsOpenBlasAtOneThreadAndRestoresItsCount) {
+  using Get = int (*)();
+  using Set = void (*)(int);
+  const auto get = reinterpret_cast<Get>(dlsym(RTLD_DEFAULT, "openblas_get_num_threads"));
+  const auto set = reinterpret_cast<Set>(dlsym(RTLD_DEFAULT, "openblas_set_num_threads"));
+  if (get == nullptr || set == nullptr) GTEST_SKIP() << "the BLAS is not OpenBLAS";
+  const int before = get();
+  set(2);
+  {
+    const BlasThreadsScope outer;
+    EXPECT_EQ(get(), 1);
+    { const BlasThreadsScope inner; }
+    EXPECT_EQ(get(), 1) << "an inner scope's end must not restore the count";
+    // A scope on another thread that ends while this one is open.
+    std::thread([&] { const BlasThreadsScope other; }).join();
+    EXPECT_EQ(get(), 1);
+  }
+  EXPECT_EQ(get(), 2);
+  // The direct solver factors and solves inside a scope; the count is back afterwards.
+  const KHarmonicSystem system = sphere_system(2, AreaWeights::Mean);
+  const auto solver = make_solver({});
+  solver->compute(system.matrix);
+  const Eigen::MatrixXd b = Eigen::MatrixXd::Ones(system.matrix.rows(), 3);
+  EXPECT_LT((system.matrix * solver->solve(b) - b).norm(), 1e-8 * b.norm());
+  EXPECT_EQ(get(), 2);
+  set(before);
 }
 
 TEST(Solver, UnsymmetricSystemIsSolvedByLuAndBicgstab) {

@@ -26,7 +26,7 @@ namespace {
 
 struct BenchEditArgs {
   std::string mesh = std::string(REMORA_REPO_DATA) + "/bunny.ply";
-  int support = 31000, frames = 60, k = 2, threads = 0;
+  int support = 31000, frames = 60, k = 2, threads = 0, regions = 1;
   std::string solver, method = "linear", energy = "rotated-laplacian";
   double frame_budget_ms = 6.0;
   bool json = false;
@@ -34,6 +34,8 @@ struct BenchEditArgs {
 
 struct BenchEditTimes {
   double load_ms = 0, preprocess_ms = 0, set_region_ms = 0;
+  /// --regions: the later regions' set_region and its parts (medians)
+  std::map<std::string, double> later_regions;
   std::vector<double> frames;                ///< sorted
   std::map<std::string, double> frame_parts; ///< medians of blend, normals, decode (nonlinear)
   double converge_ms = 0;                    ///< nonlinear: after the last frame, to converged
@@ -41,13 +43,13 @@ struct BenchEditTimes {
 };
 
 /// A geodesic support around the vertex nearest the centroid, sized so that about `support`
-/// base vertices are free, and its innermost 3 % as the handle.
-void set_geodesic_region(Editor& editor, int support) {
+/// base vertices are free (times `grow`), and its innermost 3 % as the handle.
+void set_geodesic_region(Editor& editor, int support, double grow = 1.0) {
   const Mesh& mesh = editor.input();
   const VertexHandle seed = central_vertex(mesh);
   const double ratio = double(mesh.n_vertices()) / double(editor.base().n_vertices());
   const auto wanted = static_cast<std::size_t>(
-      std::min(double(support) * 1.03, 0.9 * double(editor.base().n_vertices())) * ratio);
+      std::min(double(support) * 1.03 * grow, 0.9 * double(editor.base().n_vertices())) * ratio);
   const std::vector<int> order = geodesic_order(mesh, seed, wanted);
   const std::vector<int> handle(order.begin(),
                                 order.begin() + static_cast<long>(order.size() * 3 / 100 + 1));
@@ -85,6 +87,31 @@ std::vector<double> time_frames(Editor& editor, int count, double budget_ms,
   return frames;
 }
 
+/// Regions 2 .. a.regions, each 1 % larger than the one before (a stroke painted on), as a
+/// session meets them after its first: medians of set_region and its parts; the first region
+/// set again at the end (from the recent regions, or solved again).
+void time_later_regions(Editor& editor, const BenchEditArgs& a, BenchEditTimes& t) {
+  if (a.regions < 2) return;
+  std::map<std::string, std::vector<double>> times;
+  for (int r = 1; r < a.regions; ++r) {
+    const auto t0 = Clock::now();
+    set_geodesic_region(editor, a.support, 1.0 + 0.01 * r);
+    times["set_region"].push_back(ms_since(t0));
+    if (editor.report().region_reused)
+      throw InvalidArgument(fmt::format(
+          "bench edit --regions: region {} is the one before it (the support is capped at 90 % "
+          "of the base's vertices); use a smaller --support or fewer --regions",
+          r + 1));
+    for (const char* part : {"assemble", "factor", "solve", "encode"})
+      times[part].push_back(editor.report().milliseconds.at(part));
+  }
+  for (auto& [part, v] : times) {
+    std::sort(v.begin(), v.end());
+    t.later_regions[part] = v[v.size() / 2];
+  }
+  set_geodesic_region(editor, a.support);
+}
+
 void print_bench_edit(const BenchEditArgs& a, const EditReport& r, const BenchEditTimes& t) {
   const double median = t.frames[t.frames.size() / 2];
   if (a.json) {
@@ -97,6 +124,7 @@ void print_bench_edit(const BenchEditArgs& a, const EditReport& r, const BenchEd
                   {"frame_ms_max", t.frames.back()},
                   {"frame_parts_ms_median", t.frame_parts},
                   {"frames", t.frames.size()},
+                  {"later_regions_ms_median", t.later_regions},
                   {"method", a.method},
                   {"frame_budget_ms", a.frame_budget_ms},
                   {"converge_ms", t.converge_ms},
@@ -117,6 +145,12 @@ void print_bench_edit(const BenchEditArgs& a, const EditReport& r, const BenchEd
       t.set_region_ms, grouped(r.free_base_vertices), grouped(r.handle_base_vertices.at(0)), a.k,
       r.milliseconds.at("assemble"), r.milliseconds.at("factor"), r.milliseconds.at("solve"),
       r.milliseconds.at("encode"), grouped(r.phong.encoded), r.solver);
+  if (!t.later_regions.empty())
+    std::cout << fmt::format("set_region, regions 2 to {} (each 1 % larger): median {:.0f} ms "
+                             "(assemble {:.0f}, factor {:.0f}, solve {:.0f}, encode {:.0f})\n",
+                             a.regions, t.later_regions.at("set_region"),
+                             t.later_regions.at("assemble"), t.later_regions.at("factor"),
+                             t.later_regions.at("solve"), t.later_regions.at("encode"));
   std::cout << fmt::format("frame (blend + decode): median {:.2f} ms, max {:.2f} ms over {} "
                            "frames (medians: blend {:.2f}, normals {:.2f}, decode {:.2f})\n",
                            median, t.frames.back(), t.frames.size(), t.frame_parts.at("blend"),
@@ -151,6 +185,8 @@ void run_bench_edit(const BenchEditArgs& a) {
   t0 = Clock::now();
   set_geodesic_region(editor, a.support);
   t.set_region_ms = ms_since(t0);
+  const EditReport first = editor.report(); // the later regions' reports replace it
+  time_later_regions(editor, a, t);
   t.frames = time_frames(editor, a.frames, a.frame_budget_ms, t.frame_parts);
   // The drag stops: the nonlinear iteration goes on to convergence.
   int iterations = 0;
@@ -161,7 +197,12 @@ void run_bench_edit(const BenchEditArgs& a) {
   }
   t.converge_ms = ms_since(t0);
   t.converge_iterations = iterations;
-  print_bench_edit(a, editor.report(), t);
+  EditReport r = first;
+  for (const auto& [key, ms] : editor.report().milliseconds)
+    if (key.rfind("frame", 0) == 0) r.milliseconds[key] = ms;
+  r.nonlinear = editor.report().nonlinear;
+  r.fallback = editor.report().fallback;
+  print_bench_edit(a, r, t);
 }
 
 } // namespace
@@ -177,6 +218,10 @@ void add_bench_edit_command(CLI::App& bench) {
       ->check(CLI::PositiveNumber);
   cmd->add_option("--frames", a->frames, "Handle moves to time (default 60)")
       ->check(CLI::PositiveNumber);
+  cmd->add_option("--regions", a->regions,
+                  "Set this many regions, each 1 % larger than the one before, and report the "
+                  "later ones' median set_region too (default 1)")
+      ->check(CLI::Range(1, 1000));
   cmd->add_option("--k", a->k, "Order k (default 2)")->check(CLI::Range(1, 3));
   cmd->add_option("--solver", a->solver, "Solver (default: the direct one)");
   cmd->add_option("--method", a->method, "linear (default) or nonlinear")

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <queue>
 
 #include <Eigen/IterativeLinearSolvers>
@@ -16,6 +17,7 @@
 #endif
 
 #include "remora/common/error.h"
+#include "remora/linalg/blas_threads.h"
 
 extern "C" {
 // LAPACK (OpenBLAS): Cholesky factorization and solve of a symmetric positive definite band matrix.
@@ -118,11 +120,16 @@ public:
   bool needs_spd() const override { return true; }
   void analyze(const Sparse& a) override {
     require_square(a, "cholmod");
+    coarse_supernodes(a.rows() <= kCoarseSupernodesRows);
     llt_.analyzePattern(a);
     n_ = a.rows();
   }
   void factorize(const Sparse& a) override {
     require_finite(a, "cholmod");
+    // The analysis's flop count: a small factor runs the BLAS on one thread (blas_threads.h).
+    small_ = llt_.cholmod().fl < kThreadedBlasFlops;
+    std::optional<BlasThreadsScope> one_blas_thread;
+    if (small_) one_blas_thread.emplace();
     llt_.factorize(a);
     const cholmod_factor* l = llt_.factor();
     if (llt_.info() != Eigen::Success || l == nullptr || l->minor < l->n)
@@ -145,6 +152,8 @@ public:
     rhs.xtype = CHOLMOD_REAL;
     rhs.dtype = CHOLMOD_DOUBLE;
     cholmod_common& c = llt_.cholmod();
+    std::optional<BlasThreadsScope> one_blas_thread;
+    if (small_) one_blas_thread.emplace();
     if (!cholmod_solve2(CHOLMOD_A, l, &rhs, nullptr, &x_, nullptr, &y_, &e_, &c) || x_ == nullptr)
       throw NumericalError("cholmod: the solve failed (out of memory?)");
     return Eigen::Map<const Eigen::MatrixXd>(static_cast<const double*>(x_->x), b.rows(), b.cols());
@@ -159,7 +168,27 @@ public:
   CholmodSolver& operator=(const CholmodSolver&) = delete;
 
 private:
+  // Coarser supernodes than CHOLMOD's defaults (4, 16, 48 and 0.8, 0.1, 0.05) for a system of up
+  // to kCoarseSupernodesRows rows: a mesh's supernodes are small, and such a factor spends its
+  // time between BLAS calls, not in them. Merging more of them stores more explicit zeros, 28 %
+  // more at 479k rows for an 8 % faster factor, so larger systems keep the defaults and the
+  // region memory estimate of docs/limits.md (docs/solvers.md).
+  static constexpr Eigen::Index kCoarseSupernodesRows = 200000;
+  void coarse_supernodes(bool coarse) {
+    cholmod_common& c = llt_.cholmod();
+    const int nrelax[2][3] = {{4, 16, 48}, {16, 64, 256}};
+    const double zrelax[2][3] = {{0.8, 0.1, 0.05}, {0.9, 0.3, 0.1}};
+    for (int i = 0; i < 3; ++i) {
+      c.nrelax[i] = static_cast<std::size_t>(nrelax[coarse][i]);
+      c.zrelax[i] = zrelax[coarse][i];
+    }
+  }
+  // Below this many flops (the analysis's estimate) the factor and its solves hold the BLAS at
+  // one thread: 0.83 GFlop (the bunny's 30k-vertex thin plate) sets its region 30-40 % faster
+  // so, 9.1 GFlop (igea_sub4's 119k) factors 15 % faster on two (docs/solvers.md).
+  static constexpr double kThreadedBlasFlops = 4e9;
   bool metis_;
+  bool small_ = true;
   ExposedCholmod llt_;
   Eigen::Index n_ = 0;
   cholmod_dense* x_ = nullptr; // solution, reused by cholmod_solve2
