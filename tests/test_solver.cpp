@@ -3,8 +3,6 @@
 // reverse Cuthill-McKee shrinks the band of a scrambled grid.
 #include <gtest/gtest.h>
 
-#include <dlfcn.h>
-
 #include <algorithm>
 #include <numeric>
 #include <random>
@@ -15,6 +13,11 @@
 #include "remora/linalg/kharmonic.h"
 #include "remora/linalg/solver.h"
 #include "remora/mesh/primitives.h"
+
+extern "C" { // OpenBLAS's, when it is the BLAS (blas_threads.cpp)
+int openblas_get_num_threads() __attribute__((weak));
+void openblas_set_num_threads(int) __attribute__((weak));
+}
 
 namespace remora {
 namespace {
@@ -68,10 +71,8 @@ TEST(Solver, EverySolverAgreesWithTheDirectOneOnTheSymmetricSystem) {
 }
 
 TEST(Solver, BlasThreadsScopeHoldsOpenBlasAtOneThreadAndRestoresItsCount) {
-  using Get = int (*)();
-  using Set = void (*)(int);
-  const auto get = reinterpret_cast<Get>(dlsym(RTLD_DEFAULT, "openblas_get_num_threads"));
-  const auto set = reinterpret_cast<Set>(dlsym(RTLD_DEFAULT, "openblas_set_num_threads"));
+  const auto get = &openblas_get_num_threads;
+  const auto set = &openblas_set_num_threads;
   if (get == nullptr || set == nullptr) GTEST_SKIP() << "the BLAS is not OpenBLAS";
   const int before = get();
   set(2);
