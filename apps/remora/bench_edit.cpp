@@ -43,8 +43,9 @@ struct BenchEditTimes {
 };
 
 /// A geodesic support around the vertex nearest the centroid, sized so that about `support`
-/// base vertices are free (times `grow`), and its innermost 3 % as the handle.
-void set_geodesic_region(Editor& editor, int support, double grow = 1.0) {
+/// base vertices are free (times `grow`), and its innermost 3 % as the handle. Returns the
+/// milliseconds of set_region alone (not the selection's).
+double set_geodesic_region(Editor& editor, int support, double grow = 1.0) {
   const Mesh& mesh = editor.input();
   const VertexHandle seed = central_vertex(mesh);
   const double ratio = double(mesh.n_vertices()) / double(editor.base().n_vertices());
@@ -53,7 +54,9 @@ void set_geodesic_region(Editor& editor, int support, double grow = 1.0) {
   const std::vector<int> order = geodesic_order(mesh, seed, wanted);
   const std::vector<int> handle(order.begin(),
                                 order.begin() + static_cast<long>(order.size() * 3 / 100 + 1));
+  const auto t0 = Clock::now();
   editor.set_region(order, {handle});
+  return ms_since(t0);
 }
 
 /// positions(budget) after each of `count` handle moves (a lift and a turn), in milliseconds,
@@ -94,9 +97,7 @@ void time_later_regions(Editor& editor, const BenchEditArgs& a, BenchEditTimes& 
   if (a.regions < 2) return;
   std::map<std::string, std::vector<double>> times;
   for (int r = 1; r < a.regions; ++r) {
-    const auto t0 = Clock::now();
-    set_geodesic_region(editor, a.support, 1.0 + 0.01 * r);
-    times["set_region"].push_back(ms_since(t0));
+    times["set_region"].push_back(set_geodesic_region(editor, a.support, 1.0 + 0.01 * r));
     if (editor.report().region_reused)
       throw InvalidArgument(fmt::format(
           "bench edit --regions: region {} is the one before it (the support is capped at 90 % "
@@ -182,9 +183,7 @@ void run_bench_edit(const BenchEditArgs& a) {
   Editor editor(mesh, options);
   t.preprocess_ms = ms_since(t0);
   progress.finish();
-  t0 = Clock::now();
-  set_geodesic_region(editor, a.support);
-  t.set_region_ms = ms_since(t0);
+  t.set_region_ms = set_geodesic_region(editor, a.support);
   const EditReport first = editor.report(); // the later regions' reports replace it
   time_later_regions(editor, a, t);
   t.frames = time_frames(editor, a.frames, a.frame_budget_ms, t.frame_parts);
