@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <memory>
 #include <numeric>
 #include <random>
 #include <thread>
@@ -73,9 +74,13 @@ TEST(Solver, EverySolverAgreesWithTheDirectOneOnTheSymmetricSystem) {
 TEST(Solver, BlasThreadsScopeHoldsOpenBlasAtOneThreadAndRestoresItsCount) {
   const auto get = &openblas_get_num_threads;
   const auto set = &openblas_set_num_threads;
-  if (get == nullptr || set == nullptr) GTEST_SKIP() << "the BLAS is not OpenBLAS";
+#ifdef REMORA_LINKED_OPENBLAS
+  ASSERT_TRUE(blas_threads_held()) << "the build linked OpenBLAS (pthreads), but the scope is off";
+#endif
+  if (!blas_threads_held()) GTEST_SKIP() << "the BLAS is not OpenBLAS built with pthreads";
   const int before = get();
   set(2);
+  if (get() != 2) GTEST_SKIP() << "OpenBLAS runs one thread at most here";
   {
     const BlasThreadsScope outer;
     EXPECT_EQ(get(), 1);
@@ -86,6 +91,24 @@ TEST(Solver, BlasThreadsScopeHoldsOpenBlasAtOneThreadAndRestoresItsCount) {
     EXPECT_EQ(get(), 1);
   }
   EXPECT_EQ(get(), 2);
+  // Overlapping, not nested: the first to open ends first.
+  auto first = std::make_unique<BlasThreadsScope>();
+  auto second = std::make_unique<BlasThreadsScope>();
+  first.reset();
+  EXPECT_EQ(get(), 1) << "a scope is still open";
+  second.reset();
+  EXPECT_EQ(get(), 2);
+  // A count set while a scope is open stands.
+  int changed = 0;
+  {
+    const BlasThreadsScope scope;
+    set(3);
+    changed = get(); // 3 where OpenBLAS allows it
+  }
+  if (changed != 1) {
+    EXPECT_EQ(get(), changed) << "the count found at the start came back";
+  }
+  set(2);
   // The direct solver factors and solves inside a scope; the count is back afterwards.
   const KHarmonicSystem system = sphere_system(2, AreaWeights::Mean);
   const auto solver = make_solver({});

@@ -3,21 +3,17 @@
 #include <mutex>
 
 // OpenBLAS's thread count, declared weak: the BLAS is whatever Debian's alternatives chose, and
-// only OpenBLAS defines these (they resolve to null otherwise). Weak references resolve in the
-// linking object's own scope too, so they work in the Python module, which Python loads with
-// RTLD_LOCAL (a dlsym(RTLD_DEFAULT) lookup would not find them there).
+// only OpenBLAS defines these (they resolve to null otherwise, and with a static libopenblas.a,
+// whose members a weak reference does not pull in).
 extern "C" {
 int openblas_get_num_threads() __attribute__((weak));
 void openblas_set_num_threads(int) __attribute__((weak));
+int openblas_get_parallel() __attribute__((weak)); // 0 sequential, 1 pthreads, 2 OpenMP
 }
 
 namespace remora {
 
 namespace {
-
-bool have_openblas() {
-  return &openblas_get_num_threads != nullptr && &openblas_set_num_threads != nullptr;
-}
 
 std::mutex scope_mutex;
 int open_scopes = 0;   // guarded by scope_mutex
@@ -25,8 +21,13 @@ int saved_threads = 0; // the count before the first open scope
 
 } // namespace
 
+bool blas_threads_held() {
+  return &openblas_get_num_threads != nullptr && &openblas_set_num_threads != nullptr &&
+         &openblas_get_parallel != nullptr && openblas_get_parallel() == 1;
+}
+
 BlasThreadsScope::BlasThreadsScope() {
-  if (!have_openblas()) return;
+  if (!blas_threads_held()) return;
   const std::lock_guard lock(scope_mutex);
   if (open_scopes++ == 0) {
     saved_threads = openblas_get_num_threads();
@@ -35,9 +36,11 @@ BlasThreadsScope::BlasThreadsScope() {
 }
 
 BlasThreadsScope::~BlasThreadsScope() {
-  if (!have_openblas()) return;
+  if (!blas_threads_held()) return;
   const std::lock_guard lock(scope_mutex);
-  if (--open_scopes == 0 && saved_threads != 1) openblas_set_num_threads(saved_threads);
+  // A count changed while scopes were open (no longer 1) stands.
+  if (--open_scopes == 0 && saved_threads != 1 && openblas_get_num_threads() == 1)
+    openblas_set_num_threads(saved_threads);
 }
 
 } // namespace remora

@@ -184,8 +184,9 @@ private:
     }
   }
   // Below this many flops (the analysis's estimate) the factor and its solves hold the BLAS at
-  // one thread: 0.83 GFlop (the bunny's 30k-vertex thin plate) sets its region 30-40 % faster
-  // so, 9.1 GFlop (igea_sub4's 119k) factors 15 % faster on two (docs/solvers.md).
+  // one thread (blas_threads.h): at 0.83 GFlop (the bunny's 30k-vertex thin plate) one thread
+  // is faster, and the editor's threads after it are not slowed; at 9.1 GFlop (igea_sub4's 119k)
+  // two threads factor 15 % faster (docs/solvers.md).
   static constexpr double kThreadedBlasFlops = 4e9;
   bool metis_;
   bool small_ = true;

@@ -409,11 +409,17 @@ void Editor::install_region(Prepared&& prepared) {
   if (!prepared.state_ || prepared.state_->owner != impl_.get())
     throw InvalidArgument("install_region: the region was not prepared by this editor (or was "
                           "installed already)");
-  // The report's region figures and set_region's times; the rest stays the editor's. A copy: the
-  // region keeps its own for when it is set again from the recent ones.
+  // The report's region figures and set_region's times; the last frame's figures (its times, the
+  // method and the nonlinear iteration's) stay the editor's. A copy: the region keeps its own for
+  // when it is set again from the recent ones.
   EditReport& r = prepared.state_->report;
-  for (const auto& [key, ms] : impl_->report.milliseconds)
+  const EditReport& last = impl_->report;
+  for (const auto& [key, ms] : last.milliseconds)
     if (key.rfind("frame", 0) == 0) r.milliseconds[key] = ms;
+  r.method = last.method;
+  r.nonlinear = last.nonlinear;
+  r.nonlinear_level = last.nonlinear_level;
+  r.fallback = last.fallback;
   impl_->report = r;
   if (impl_->region) {
     impl_->recent.push_front(std::move(impl_->region));
