@@ -28,7 +28,7 @@ done
 
 packages=(
   build-essential cmake pkg-config clang-format
-  clang libomp-dev libclang-rt-14-dev
+  clang lld libomp-dev libclang-rt-14-dev
   libopenmesh-dev libeigen3-dev
   libsuitesparse-dev libmetis-dev libopenblas-dev
   libcli11-dev nlohmann-json3-dev libspdlog-dev libfmt-dev libcpp-httplib-dev

@@ -6,6 +6,11 @@
 #
 #   scripts/build_web.sh OUT_DIR
 #
+# kernel.wasm, the page's frames (web/wasm/kernel.cpp and the library's
+# src/remora/multires/frame_replay.cpp for wasm32), is built with clang++ and wasm-ld (Debian's
+# clang and lld); without them the page evaluates its frames in JavaScript, about half as fast,
+# and this says so.
+#
 # The registry is reached over the network, which fails now and then, and npm by default waits 5
 # minutes on a silent connection: here npm gives up on one after 60 s and retries each request
 # itself, and the whole `npm ci` is tried up to REMORA_NPM_ATTEMPTS times (default 3) with a
@@ -53,3 +58,16 @@ cp "$web/node_modules/three/examples/jsm/controls/OrbitControls.js" \
    "$web/node_modules/three/examples/jsm/controls/TransformControls.js" \
    "$out/three/examples/jsm/controls/"
 cp "$web/node_modules/three/LICENSE" "$out/three/LICENSE"
+
+# The page's frames in WebAssembly: freestanding (no C library, and -fno-builtin keeps the
+# compiler from calling a memset that none provides), the memory laid out by kernel.js.
+wasm_tools() { command -v "${CLANGXX:-clang++}" >/dev/null && command -v wasm-ld >/dev/null; }
+if wasm_tools; then
+  "${CLANGXX:-clang++}" --target=wasm32 -std=c++20 -O3 -msimd128 -nostdlib -fno-builtin -fno-exceptions \
+    -fno-rtti -Wall -Wextra -Werror -I"$here/src" -Wl,--no-entry -Wl,--export=__heap_base \
+    -o "$out/kernel.wasm.tmp" "$web/wasm/kernel.cpp" "$here/src/remora/multires/frame_replay.cpp"
+  mv "$out/kernel.wasm.tmp" "$out/kernel.wasm"
+else
+  rm -f "$out/kernel.wasm"
+  echo "build_web: no clang++ or wasm-ld (Debian: clang, lld): the page's frames run in JavaScript"
+fi

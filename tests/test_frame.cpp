@@ -1,6 +1,7 @@
 // One frame of the editor (multires/frame.h): the blend of the basis functions against the dense
 // product, the normals of a region against vertex_normals() of the whole mesh, the decode
-// against decode_phong(), bit for bit; and the frame exported for a client (frame_export.h).
+// against decode_phong(), bit for bit; and the frame exported for a client (frame_export.h),
+// replayed here and by the library's client replay (frame_replay.h, the page's kernel.wasm).
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -15,6 +16,7 @@
 #include "remora/multires/editor.h"
 #include "remora/multires/frame.h"
 #include "remora/multires/frame_export.h"
+#include "remora/multires/frame_replay.h"
 #include "remora/multires/motion_blend.h"
 #include "remora/multires/phong_decode.h"
 
@@ -216,7 +218,10 @@ Eigen::MatrixXd replay_export(const FrameExport& f, const std::vector<Transform>
   return out;
 }
 
-TEST(FrameExport, ReplayedInSinglePrecisionGivesTheEditorsPositions) {
+// A bumpy sphere with two handles, one turned and stretched, one moved: the editor of each detail
+// mode, its transforms set, passed to check(editor, transforms, mode).
+template <typename Check>
+void for_each_export_case(const Check& check) {
   Mesh mesh = make_icosphere(4, 1.0);
   for (const VertexHandle v : mesh.vertices()) {
     const Vec3 p = mesh.point(v);
@@ -234,6 +239,13 @@ TEST(FrameExport, ReplayedInSinglePrecisionGivesTheEditorsPositions) {
     Editor editor(mesh, options);
     editor.set_region(support, handles);
     for (int j = 0; j < 2; ++j) editor.set_transform(j, transforms[std::size_t(j)]);
+    check(editor, transforms, mode);
+  }
+}
+
+TEST(FrameExport, ReplayedInSinglePrecisionGivesTheEditorsPositions) {
+  for_each_export_case([](Editor& editor, const std::vector<Transform>& transforms,
+                          DetailMode mode) {
     const FrameExport f = frame_export(editor);
     EXPECT_EQ(f.offsets.empty(), mode == DetailMode::Normal);
     const std::vector<int>& movable = editor.movable_vertices();
@@ -260,7 +272,80 @@ TEST(FrameExport, ReplayedInSinglePrecisionGivesTheEditorsPositions) {
     }
     EXPECT_LT(worst_blend, 1e-5) << "detail mode " << int(mode);
     EXPECT_GT(apart, 1e-3); // blended motions are not the linear frame
-  }
+  });
+}
+
+// The library's client replay (frame_replay.h), which the page runs as WebAssembly, over an
+// export: a linear frame, x, y, z per movable vertex in single precision (NaN where no record
+// wrote).
+std::vector<float> replay_with_library(const FrameExport& f,
+                                       const std::vector<Transform>& transforms,
+                                       std::size_t movable) {
+  FrameReplay r;
+  r.handles = std::uint32_t(f.handles);
+  r.rows = std::uint32_t(f.free_local.size());
+  r.columns = 3 + 4 * r.handles;
+  r.normal_count = std::uint32_t(f.normal_vertices.size());
+  r.record_count = std::uint32_t(f.record_face.size());
+  for (const std::uint32_t t : f.ring) r.ring_faces = std::max(r.ring_faces, t + 1);
+  r.rest = f.rest.data();
+  r.free_local = f.free_local.data();
+  r.basis = f.basis.data();
+  r.handle_begin = f.handle_begin.data();
+  r.handle_local = f.handle_local.data();
+  r.faces = f.faces.data();
+  r.normal_vertices = f.normal_vertices.data();
+  r.ring_begin = f.ring_begin.data();
+  r.ring = f.ring.data();
+  r.record_face = f.record_face.data();
+  r.record_slot = f.record_slot.data();
+  r.record_bary = f.record_bary.data();
+  r.record_offset = f.record_offset.data();
+  r.record_residual = f.record_residual.data();
+  r.residuals = f.residuals.data();
+  r.offsets = f.offsets.empty() ? nullptr : f.offsets.data();
+  std::vector<double> x(f.rest.begin(), f.rest.end()), cross(3 * std::size_t(r.ring_faces));
+  r.x = x.data();
+  r.cross = cross.data();
+  std::vector<double> maps;
+  for (const Transform& t : transforms)
+    for (int row = 0; row < 3; ++row)
+      for (int col = 0; col < 4; ++col) maps.push_back(t(row, col));
+  std::vector<float> out(3 * movable, std::nanf(""));
+  replay_blend(r, maps.data());
+  replay_move_handles(r, maps.data());
+  replay_normals(r);
+  replay_decode(r, out.data());
+  return out;
+}
+
+TEST(FrameReplay, TheLibrarysReplayGivesTheEditorsPositionsAndTheTestsReplay) {
+  for_each_export_case(
+      [](Editor& editor, const std::vector<Transform>& transforms, DetailMode mode) {
+        const FrameExport f = frame_export(editor);
+        const std::vector<int>& movable = editor.movable_vertices();
+        const std::vector<float> library = replay_with_library(f, transforms, movable.size());
+        const Eigen::MatrixXd tests = replay_export(f, transforms, movable.size());
+        const Eigen::MatrixXd& p = editor.positions();
+        double to_editor = 0.0, to_test = 0.0;
+        for (std::size_t i = 0; i < movable.size(); ++i)
+          for (int c = 0; c < 3; ++c) {
+            const double q = library[3 * i + std::size_t(c)];
+            ASSERT_TRUE(std::isfinite(q)) << "movable vertex " << i << " not written";
+            to_editor = std::max(to_editor, std::abs(q - p(movable[i], c)));
+            to_test = std::max(to_test, std::abs(q - tests(Eigen::Index(i), c)));
+          }
+        EXPECT_LT(to_editor, 1e-5) << "detail mode " << int(mode); // the sphere's diagonal is 3.5
+        // The same arithmetic in double precision, rounded to single once at the end.
+        EXPECT_LT(to_test, 1e-6) << "detail mode " << int(mode);
+        // A map that the replay does not apply is seen: the identity's frame is far from it.
+        const std::vector<float> rest =
+            replay_with_library(f, {Transform::Identity(), Transform::Identity()}, movable.size());
+        double apart = 0.0;
+        for (std::size_t i = 0; i < rest.size(); ++i)
+          apart = std::max(apart, std::abs(double(rest[i]) - double(library[i])));
+        EXPECT_GT(apart, 0.1);
+      });
 }
 
 } // namespace

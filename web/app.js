@@ -9,7 +9,7 @@ import { ApiError, api, binary, json, message, post, task, waitUntilReady, work 
 import * as view from './view.js';
 import { FIXED, FREE } from './view.js';
 import { Coalescer, faceNormal, pick } from './picking.js';
-import { evaluateKernel, parseKernel } from './kernel.js';
+import { engine, evaluateKernel, loadEngine, parseKernel } from './kernel.js';
 import * as panels from './panels.js';
 
 const $ = (id) => document.getElementById(id);
@@ -26,6 +26,9 @@ for (const id of ['show-base', 'show-wire', 'show-mesh', 'show-edges'])
 // Not for rendering: page-frames=0, the drags' frames from the server for method linear too
 // (web/kernel.js evaluates them in the page otherwise).
 const pageFrames = params.get('page-frames') !== '0';
+// Not for rendering: kernel=js, the page's frames evaluated in JavaScript even where kernel.wasm
+// is there (the benchmark compares both engines).
+const kernelInJs = params.get('kernel') === 'js';
 const areaRange = Number(params.get('area-range')) > 0 ? Number(params.get('area-range')) : 0.2;
 let cameraParam = params.has('camera') ? params.get('camera').split(',').map(Number) : null;
 if (cameraParam && !((cameraParam.length === 6 || cameraParam.length === 9) && cameraParam.every(Number.isFinite))) {
@@ -124,12 +127,13 @@ async function fetchRegion(s, labelsKnown) {
 // answer) and answers the last one of the drag, whose positions the page then shows. Until the kernel is here, and for the nonlinear
 // energies that iterate, the server's answers are the frames.
 let kernel = null; // { regionId, data, out }
+const engineLoaded = kernelInJs ? Promise.resolve('js') : loadEngine();
 function loadKernel(s) {
   kernel = null;
   const computable = s.region?.method === 'linear' || s.region?.energy === 'blended-motions';
   if (!pageFrames || !computable || !state.movable) return;
   const regionId = s.region_id, movable = state.movable;
-  fetch('api/region/kernel').then((r) => (r.ok ? r.arrayBuffer() : null)).then((buffer) => {
+  Promise.all([fetch('api/region/kernel').then((r) => (r.ok ? r.arrayBuffer() : null)), engineLoaded]).then(([buffer]) => {
     if (!buffer || state.held.region !== regionId || state.movable !== movable) return;
     const data = parseKernel(buffer);
     kernel = { regionId, data, out: new Float32Array(3 * movable.length) };
@@ -587,8 +591,11 @@ window.remora = {
   labels: () => Array.from(state.labels ?? []),
   positionsHeld: () => state.positions,
   /// The page's own frame (kernel.js) under `transforms` (per handle the 12 numbers of [M | t]),
-  /// x, y, z per movable vertex; null before the region's kernel is here.
-  kernelFrame: (transforms) => (kernelUsable() ? Array.from(evaluateKernel(kernel.data, transforms, new Float32Array(kernel.out.length))) : null),
+  /// x, y, z per movable vertex; null before the region's kernel is here. how: the engine, 'wasm'
+  /// (when the page has it) or 'js'.
+  kernelFrame: (transforms, how = 'wasm') => (kernelUsable() ? Array.from(evaluateKernel(kernel.data, transforms, new Float32Array(kernel.out.length), how)) : null),
+  /// The engine of the page's frames: 'wasm' (kernel.wasm) or 'js'.
+  kernelEngine: () => (kernelUsable() && kernel.data.wasm ? 'wasm' : engine()),
   movableHeld: () => Array.from(state.movable ?? []),
   indicesHeld: () => state.indices,
   tool: () => state.tool,
@@ -600,6 +607,8 @@ window.remora = {
     for (let i = 0; i < a.length; ++i) worst = Math.max(worst, Math.abs(a[i] - b[i]));
     return worst;
   },
+  /// Where a drag's normals are computed: 'wasm' (kernel.wasm) or 'js'.
+  normalsEngine: () => view.normalsEngine(),
   marks: () => JSON.parse(JSON.stringify(state.marks)),
   setDrawing: (on) => view.setDrawing(on),
   meshName: () => state.status?.mesh?.name,

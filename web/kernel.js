@@ -5,6 +5,12 @@
 // phong_decode.h) on the data of `GET /api/region/kernel` (single precision). The server stays
 // the reference: the page sends every map to it and shows its answer at the end of a drag;
 // web/tests/e2e.mjs checks that both agree.
+//
+// Two engines give the same numbers (bit for bit: the same operations in the same order, in
+// double precision): kernel.wasm, the library's own replay (src/remora/multires/frame_replay.h)
+// compiled to WebAssembly by scripts/build_web.sh, about twice as fast; and the JavaScript
+// below, used when the page was built without it (no clang or wasm-ld) and for the steps the
+// library's replay leaves to its caller (blended motions' step 1).
 
 const HEADER_WORDS = 16;
 
@@ -43,6 +49,8 @@ export function parseKernel(buffer) {
   if (at !== buffer.byteLength || columns !== 3 + 4 * handles)
     throw new Error(`region kernel: ${buffer.byteLength} bytes, its header describes ${at}`);
   sortRecords(k);
+  k.slots = 0; // the movable vertices the records write: max slot + 1
+  for (let r = 0; r < records; ++r) k.slots = Math.max(k.slots, k.recordSlot[r] + 1);
   let ringFaces = 0;
   for (let i = 0; i < k.ring.length; ++i) ringFaces = Math.max(ringFaces, k.ring[i] + 1);
   k.ringFaces = ringFaces; // the normals' faces come first among the faces
@@ -65,7 +73,66 @@ export function parseKernel(buffer) {
       for (let c = 0; c < 3; ++c) o[c] += k.rest[6 * k.handleLocal[i] + c] / count;
     k.pivots.push(o);
   }
+  if (wasmModule) attachWasm(k);
   return k;
+}
+
+// ---- the WebAssembly engine ---------------------------------------------------------------------
+let wasmModule = null;
+
+/// Compiles the page's kernel.wasm once (its URL relative to the page); without it (a build with
+/// no WebAssembly tools, or a failed fetch) the frames are evaluated in JavaScript. Resolves to
+/// the engine the next kernels use: 'wasm' or 'js'.
+export async function loadEngine(url = 'kernel.wasm') {
+  try {
+    const response = await fetch(url);
+    if (!response.ok) throw new Error(`${url}: ${response.status}`);
+    wasmModule = await WebAssembly.compile(await response.arrayBuffer());
+  } catch (e) {
+    wasmModule = null;
+    console.info(`the page's frames run in JavaScript (${e.message})`);
+  }
+  return engine();
+}
+export const engine = () => (wasmModule ? 'wasm' : 'js');
+/// The compiled kernel.wasm, or null (web/normals.js's wasmNormals() instantiates it too).
+export const wasmEngine = () => wasmModule;
+
+/// Copies the kernel's arrays into the memory of a new instance of kernel.wasm (one per region:
+/// its memory goes with the kernel) and lays out struct FrameReplay (frame_replay.h: 24 words of
+/// 4 bytes) over them. k.xn becomes the instance's working rows, so that the JavaScript steps
+/// (blended motions) write where the WebAssembly ones read.
+function attachWasm(k) {
+  const instance = new WebAssembly.Instance(wasmModule, {});
+  const w = instance.exports;
+  let at = w.__heap_base.value;
+  const sections = [];
+  const reserve = (bytes) => {
+    at = (at + 7) & ~7;
+    at += bytes;
+    return at - bytes;
+  };
+  const place = (array) => {
+    if (!array) return 0; // a null pointer: no offsets
+    const offset = reserve(array.BYTES_PER_ELEMENT * array.length);
+    sections.push([offset, array]);
+    return offset;
+  };
+  const arrays = [k.rest, k.freeLocal, k.basis, k.handleBegin, k.handleLocal, k.faces, k.normalVertices, k.ringBegin,
+    k.ring, k.recordFace, k.recordSlot, k.recordBary, k.recordOffset, k.recordResidual, k.residuals, k.offsets];
+  const pointers = arrays.map(place);
+  const x = reserve(8 * 6 * k.local), cross = reserve(8 * 3 * k.ringFaces);
+  const transforms = reserve(8 * 12 * k.handles), out = reserve(4 * 3 * k.slots), struct = reserve(4 * 24);
+  const grow = Math.ceil((at - w.memory.buffer.byteLength) / 65536);
+  if (grow > 0) w.memory.grow(grow);
+  const memory = w.memory.buffer;
+  for (const [offset, array] of sections) new array.constructor(memory, offset, array.length).set(array);
+  new Uint32Array(memory, struct, 24).set([k.handles, k.rows, k.columns, k.normalVertices.length, k.records,
+    k.ringFaces, ...pointers, x, cross]);
+  k.xn = new Float64Array(memory, x, 6 * k.local);
+  k.xn.set(k.rest);
+  k.wasm = { exports: w, struct, transforms, out, maps: new Float64Array(memory, transforms, 12 * k.handles),
+             result: new Float32Array(memory, out, 3 * k.slots) };
 }
 
 /// Puts the records in the order of their faces' first corners. The server sends them in the
@@ -92,7 +159,20 @@ function sortRecords(k) {
 /// Positions (x, y, z per slot, the order of the region's movable vertices) into `out`
 /// (Float32Array, 3 per movable vertex) under `transforms`: per handle the 12 numbers of the rows
 /// of [M | t] (identity for a missing one).
-export function evaluateKernel(k, transforms, out) {
+/// `engine`: 'wasm' (when the kernel has it) or 'js', for the test that compares them.
+export function evaluateKernel(k, transforms, out, engine = 'wasm') {
+  if (k.wasm && engine === 'wasm') {
+    const w = k.wasm;
+    if (k.blended) {
+      blendMotions(k, transforms);
+      w.exports.frame_after_blend(w.struct, w.out);
+    } else {
+      for (let j = 0; j < k.handles; ++j) w.maps.set(transforms[j] ?? IDENTITY, 12 * j);
+      w.exports.frame_linear(w.struct, w.transforms, w.out);
+    }
+    out.set(w.result.length <= out.length ? w.result : w.result.subarray(0, out.length));
+    return out;
+  }
   if (k.blended) blendMotions(k, transforms);
   else blend(k, transforms);
   normals(k);

@@ -2,6 +2,8 @@
 // formula as three.js's BufferGeometry.computeVertexNormals() (the sum of the unnormalized face
 // normals (c - b) x (a - b) over a vertex's faces, then normalized), evaluated only where a moved
 // vertex can change it. web/tests/e2e.mjs checks the result against computeVertexNormals().
+// Where the page has kernel.wasm, wasmNormals() computes the same sums there (display_normals()
+// in web/wasm/kernel.cpp), in double precision.
 
 /// The faces around each vertex, built once per mesh: faces(v) are the face offsets (3 f) in
 /// faces[begin[v] .. begin[v + 1]). indices: Uint32 triples.
@@ -68,4 +70,64 @@ export function updateNormals(positions, indices, normals, plan) {
     const length = Math.sqrt(x * x + y * y + z * z) || 1;
     n[3 * v] = x / length; n[3 * v + 1] = y / length; n[3 * v + 2] = z / length;
   }
+}
+
+/// The plan's normals in an instance of kernel.wasm (`module`), for the frames of one region:
+/// update(positions, moved) takes the drawn positions (the moved vertices already written) and
+/// `moved` (x, y, z per movable vertex, in the order of `movable`) and writes the plan's normals
+/// into `normals`, as updateNormals() does. `map`: the drawn vertex's mesh vertex (crease copies),
+/// or null; meshVertices: the mesh's vertex count.
+export function wasmNormals(module, indices, plan, movable, map, meshVertices) {
+  const drawn = plan.affected.length;
+  // Where each drawn corner's position is: the slot of its mesh vertex among the moved ones, or
+  // one of the constant positions (corners that do not move), gathered each frame.
+  const slotOfMesh = new Int32Array(meshVertices).fill(-1);
+  for (let i = 0; i < movable.length; ++i) slotOfMesh[movable[i]] = i;
+  const reference = new Int32Array(drawn).fill(-1), constants = [];
+  const target = new Int32Array(drawn).fill(-1);
+  for (let i = 0; i < plan.vertices.length; ++i) target[plan.vertices[i]] = i;
+  const faces = plan.faces.length, corner = new Uint32Array(3 * faces), toward = new Int32Array(3 * faces);
+  for (let f = 0; f < faces; ++f)
+    for (let k = 0; k < 3; ++k) {
+      const d = indices[plan.faces[f] + k];
+      if (reference[d] < 0) {
+        const slot = slotOfMesh[map ? map[d] : d];
+        if (slot >= 0) reference[d] = slot;
+        else { reference[d] = movable.length + constants.length; constants.push(d); }
+      }
+      corner[3 * f + k] = reference[d];
+      toward[3 * f + k] = target[d];
+    }
+  const instance = new WebAssembly.Instance(module, {});
+  const w = instance.exports;
+  let at = w.__heap_base.value;
+  const reserve = (bytes) => { at = (at + 7) & ~7; at += bytes; return at - bytes; };
+  const vertices = plan.vertices.length, positionCount = movable.length + constants.length;
+  const cornerAt = reserve(4 * corner.length), targetAt = reserve(4 * toward.length);
+  const positionsAt = reserve(12 * positionCount), sumsAt = reserve(24 * vertices), normalsAt = reserve(12 * vertices);
+  const struct = reserve(4 * 7);
+  const grow = Math.ceil((at - w.memory.buffer.byteLength) / 65536);
+  if (grow > 0) w.memory.grow(grow);
+  const memory = w.memory.buffer;
+  new Uint32Array(memory, cornerAt, corner.length).set(corner);
+  new Int32Array(memory, targetAt, toward.length).set(toward);
+  new Uint32Array(memory, struct, 7).set([faces, vertices, cornerAt, targetAt, positionsAt, sumsAt, normalsAt]);
+  const moving = new Float32Array(memory, positionsAt, 3 * movable.length);
+  const fixed = new Float32Array(memory, positionsAt + 12 * movable.length, 3 * constants.length);
+  const result = new Float32Array(memory, normalsAt, 3 * vertices), still = Uint32Array.from(constants);
+  return {
+    update(positions, moved, normals) {
+      moving.set(moved);
+      for (let i = 0; i < still.length; ++i) {
+        const d = still[i];
+        fixed[3 * i] = positions[3 * d]; fixed[3 * i + 1] = positions[3 * d + 1]; fixed[3 * i + 2] = positions[3 * d + 2];
+      }
+      w.display_normals(struct);
+      const list = plan.vertices;
+      for (let i = 0; i < list.length; ++i) {
+        const v = list[i];
+        normals[3 * v] = result[3 * i]; normals[3 * v + 1] = result[3 * i + 1]; normals[3 * v + 2] = result[3 * i + 2];
+      }
+    },
+  };
 }

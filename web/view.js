@@ -4,7 +4,8 @@
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 import { TransformControls } from 'three/addons/controls/TransformControls.js';
-import { normalPlan, updateNormals, vertexFaces } from './normals.js';
+import { normalPlan, updateNormals, vertexFaces, wasmNormals } from './normals.js';
+import { wasmEngine } from './kernel.js';
 import { splitCreases, withCopies } from './creases.js';
 
 export const FIXED = -2, FREE = -1;
@@ -75,6 +76,7 @@ const edgeMaterial = new THREE.MeshBasicMaterial({ color: 0x30343c, wireframe: t
 /// The drawn objects (null until there is something to draw).
 export const shown = { mesh: null, edges: null, baseLines: null, baseSurface: null };
 let plan = null; // normalPlan() of the current movable vertices (display ids)
+let planInWasm = null; // its normals in kernel.wasm (wasmNormals()), when the page has it
 let around = null; // vertexFaces() of the drawn mesh
 // The mesh as drawn: splitCreases() of it, or null when the display is the mesh itself; the mesh's
 // positions (held, not copied); the display copies of the movable vertices.
@@ -140,6 +142,7 @@ export function setMesh(positions, indices) {
   scene.add(shown.mesh);
   scene.add(shown.edges);
   plan = null;
+  planInWasm = null;
   around = vertexFaces(geometry.getIndex().array, n);
   redraw();
 }
@@ -169,7 +172,11 @@ export function setMovable(movable) {
   const ids = movable && display ? withCopies(movable, display.copies) : movable;
   plan = ids ? normalPlan(g.getIndex().array, around, ids) : null;
   movedCopies = ids && display ? ids.slice(movable.length) : [];
+  const module = wasmEngine();
+  planInWasm = plan && module ? wasmNormals(module, g.getIndex().array, plan, movable, display?.map ?? null, meshPositions.length / 3) : null;
 }
+
+export const normalsEngine = () => (planInWasm ? 'wasm' : 'js');
 
 /// A drag's frame: moved holds x, y, z for each of movable (setMovable's ids, in that order).
 /// Recomputes the normals that can change and uploads only the range that holds them.
@@ -186,7 +193,8 @@ export function applyMoved(movable, moved) {
     const v = display.map[d];
     p[3 * d] = meshPositions[3 * v]; p[3 * d + 1] = meshPositions[3 * v + 1]; p[3 * d + 2] = meshPositions[3 * v + 2];
   }
-  updateNormals(p, g.getIndex().array, normal.array, plan);
+  if (planInWasm) planInWasm.update(p, moved, normal.array);
+  else updateNormals(p, g.getIndex().array, normal.array, plan);
   if (plan.last < plan.first) return;
   touch(position, plan.first, plan.last);
   touch(normal, plan.first, plan.last);

@@ -403,12 +403,13 @@ HttpResponse serve_static(const std::string& root, const std::string& path) {
   HttpResponse r;
   r.body = bytes.str();
   const std::string ext = file.extension().string();
-  r.content_type = ext == ".html"  ? "text/html; charset=utf-8"
-                   : ext == ".js"  ? "text/javascript; charset=utf-8"
-                   : ext == ".mjs" ? "text/javascript; charset=utf-8"
-                   : ext == ".css" ? "text/css; charset=utf-8"
-                   : ext == ".png" ? "image/png"
-                                   : "application/octet-stream";
+  r.content_type = ext == ".html"   ? "text/html; charset=utf-8"
+                   : ext == ".js"   ? "text/javascript; charset=utf-8"
+                   : ext == ".mjs"  ? "text/javascript; charset=utf-8"
+                   : ext == ".css"  ? "text/css; charset=utf-8"
+                   : ext == ".png"  ? "image/png"
+                   : ext == ".wasm" ? "application/wasm"
+                                    : "application/octet-stream";
   return r;
 }
 

@@ -19,13 +19,14 @@
 //                        (--server-frames: the server's frames instead); kernel_bytes, the region's
 //                        kernel, and kernel_after_mouseup_ms, its arrival after the handle stroke's
 //                        mouse-up (compare mouseup_to_gizmo_ms);
-//   bytes_per_frame      the transform answer's size; support_vertices, the region's support.
+//   bytes_per_frame      the transform answer's size; support_vertices, the region's support;
+//   kernel_engine        'wasm' (kernel.wasm) or 'js' (--kernel js, or a page built without it).
 // The pointer moves one step per 1/60 s (a browser delivers moves once per display frame). All
 // medians. The last line printed is one JSON object with these keys.
 //
 //   node web/tests/bench.mjs --cli build/bin/remora --web-root build/web [--mesh data/bunny.ply]
 //        [--support-radius R] [--moves N] [--method linear|nonlinear|blended-motions] [--quick]
-//        [--server-frames]
+//        [--server-frames] [--kernel js]
 // R is in the mesh's units (default: a fifth of its bounding radius); the support is painted at
 // the surface under the view's centre. --method: the page's method switch, set before the support
 // is painted (default linear). --quick: no drawn figures and no bake (their keys are
@@ -35,6 +36,7 @@ import { args, chromiumOrSkip, client, drag, ready, startServer } from './harnes
 const moves = Number(args.moves ?? 30);
 const quick = 'quick' in args;
 const serverFrames = 'server-frames' in args;
+const query = [serverFrames ? 'page-frames=0' : '', args.kernel === 'js' ? 'kernel=js' : ''].filter(Boolean).join('&');
 // Pointer moves come one per display frame at 60 Hz, as a browser delivers them (it aligns them
 // with its frames), not as fast as the driver can send them.
 const frame = 1000 / 60;
@@ -48,7 +50,7 @@ let failed = false;
 try {
   const page = await browser.newPage({ viewport: { width: 1200, height: 800 } });
   page.on('pageerror', (e) => { console.log('page error:', e.message); failed = true; });
-  await page.goto(serverFrames ? url + '?page-frames=0' : url);
+  await page.goto(query ? `${url}?${query}` : url);
   await ready(page, 600000);
   if (args.method) await page.selectOption('#method', args.method);
   const marks = () => page.evaluate(() => window.remora.marks());
@@ -131,6 +133,7 @@ try {
     drag_kernel_ms: round(median(hidden.kernel)),
     kernel_after_mouseup_ms: round(kernelMark ? kernelMark.at - afterKernel.strokeEnd : null),
     kernel_bytes: kernelMark?.bytes ?? null,
+    kernel_engine: await page.evaluate(() => window.remora.kernelEngine()),
     drag_cycle_shown_ms: round(median(shown.ms)), bake_ms: round(bake),
     bytes_per_frame: median([...shown.bytes, ...hidden.bytes]), support_vertices: support,
     paint_moves: paintMove.length + paintMoveShown.length, drag_frames: hidden.ms.length + shown.ms.length,

@@ -132,7 +132,9 @@ async function core(page, log) {
   check(pageOff < 1e-6, `after the drag the page holds the server's positions (off by ${pageOff})`);
   await kernelAgrees(page, { api, floats, json }, before, region, t);
   const normalError = await page.evaluate(() => window.remora.normalError?.() ?? Infinity);
-  check(normalError < 1e-5, `after the drag the page's normals equal a full computeVertexNormals() (off by ${normalError.toExponential(2)})`);
+  const normalsEngine = await page.evaluate(() => window.remora.normalsEngine());
+  check(normalError < 1e-5 && normalsEngine === await page.evaluate(() => window.remora.kernelEngine()),
+        `after the drag the page's normals (${normalsEngine}) equal a full computeVertexNormals() (off by ${normalError.toExponential(2)})`);
   await shot(page, large ? 'editor-large-dragged.png' : 'editor-dragged.png');
   if (!large) {
     // The hidden base and its wireframe coloured by vertex area.

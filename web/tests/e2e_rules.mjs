@@ -1,8 +1,9 @@
 // The editor's rules a new user meets, checked with the mouse and the keyboard on the bunny
 // (web/tests/e2e.mjs runs them before and after its core edit), the URL's display options, the
 // creases of a CAD-like part, and a broken upload's message.
+import { existsSync } from 'node:fs';
 import { join } from 'node:path';
-import { boxObj, check, drag, ready, stroke } from './harness.mjs';
+import { args, boxObj, check, drag, ready, stroke } from './harness.mjs';
 
 const remora = (page, what, ...a) => page.evaluate(([w, b]) => {
   const f = window.remora[w];
@@ -344,6 +345,14 @@ export async function kernelAgrees(page, c, rest, region, dragged, what = 'the p
   for (let i = 0; i < server.length && worst < Infinity; ++i) worst = Math.max(worst, Math.abs(local[i] - server[i]));
   check(worst <= 1e-5 * diagonal, `${what} equals the server's under a rotation and a scaling ` +
         `(${server.length / 3} vertices, off by ${worst.toExponential(2)}, bound ${(1e-5 * diagonal).toExponential(2)})`);
+  // Both engines: kernel.wasm (the library's replay) where the build has it, and the JavaScript.
+  const engine = await page.evaluate(() => window.remora.kernelEngine());
+  const wasmBuilt = existsSync(join(args['web-root'] ?? '', 'kernel.wasm'));
+  check(engine === (wasmBuilt ? 'wasm' : 'js'), `${what} runs in ${engine} (kernel.wasm ${wasmBuilt ? '' : 'not '}built)`);
+  const js = await page.evaluate((t) => window.remora.kernelFrame([t], 'js'), rows);
+  let apart = js && local && js.length === local.length ? 0 : Infinity;
+  for (let i = 0; i < local.length && apart < Infinity; ++i) apart = Math.max(apart, Math.abs(js[i] - local[i]));
+  check(apart === 0, `${what}: WebAssembly and JavaScript give the same numbers (apart by ${apart})`);
   await post(dragged);
 }
 
