@@ -186,8 +186,8 @@ TEST(ServerEditing, UndoAndRedoThroughLocalBakesAreExact) {
 }
 
 // The region's kernel (GET /api/region/kernel): sections that add up to the body as its header
-// says; served for method linear and the energy blended-motions only. A move answered with "none" is a 204 without positions
-// that moves the server's shape all the same.
+// says; served for method linear and the energy blended-motions only. A move answered with
+// "none" is a 204 without positions that moves the server's shape all the same, when it is read.
 TEST(ServerEditing, TheKernelIsServedForFramesThatDoNotIterateAndAMoveCanGoUnanswered) {
   Session s;
   ASSERT_EQ(call(s, "POST", "/api/load", sphere_off(), {{"name", "sphere.off"}}).status, 202);
@@ -220,7 +220,21 @@ TEST(ServerEditing, TheKernelIsServedForFramesThatDoNotIterateAndAMoveCanGoUnans
   EXPECT_EQ(quiet.status, 204);
   EXPECT_TRUE(quiet.body.empty());
   EXPECT_EQ(status_of(s)["transforms"][0][11], 0.3);
-  EXPECT_EQ(as<float>(move(s, lift)).size(), 3 * r.support.size());
+  // Its frame is computed when the shape is read: a pick from above meets the lifted cap (the
+  // sphere's top is at z = 1 at rest), and the positions are those of the answered move.
+  const HttpResponse top =
+      call(s, "POST", "/api/pick", R"({"origin": [0, 0, 5], "direction": [0, 0, -1]})");
+  ASSERT_EQ(top.status, 200) << top.body;
+  std::istringstream hit(top.headers.at("X-Hit-Point"));
+  double hx = 0, hy = 0, hz = 0;
+  hit >> hx >> hy >> hz;
+  EXPECT_NEAR(hz, 1.3, 0.05);
+  const std::vector<float> lifted = as<float>(call(s, "GET", "/api/mesh/positions"));
+  const std::vector<float> answered = as<float>(move(s, lift));
+  ASSERT_EQ(answered.size(), 3 * r.support.size());
+  for (std::size_t i = 0; i < r.support.size(); ++i)
+    for (std::size_t c = 0; c < 3; ++c)
+      EXPECT_EQ(lifted[3 * std::size_t(r.support[i]) + c], answered[3 * i + c]);
   expect_error(call(s, "POST", "/api/transform",
                     nlohmann::json{{"handle", 0}, {"matrix", lift}, {"answer", "all"}}.dump()),
                400, "answer");

@@ -9,7 +9,8 @@ import { ApiError, api, binary, json, message, post, task, waitUntilReady, work 
 import * as view from './view.js';
 import { FIXED, FREE } from './view.js';
 import { Coalescer, faceNormal, pick } from './picking.js';
-import { engine, evaluateKernel, loadEngine, parseKernel } from './kernel.js';
+import { evaluateKernel, parseKernel, releaseKernel } from './kernel.js';
+import { engine, loadEngine } from './engine.js';
 import * as panels from './panels.js';
 
 const $ = (id) => document.getElementById(id);
@@ -129,6 +130,7 @@ async function fetchRegion(s, labelsKnown) {
 let kernel = null; // { regionId, data, out }
 const engineLoaded = kernelInJs ? Promise.resolve('js') : loadEngine();
 function loadKernel(s) {
+  releaseKernel(kernel?.data);
   kernel = null;
   const computable = s.region?.method === 'linear' || s.region?.energy === 'blended-motions';
   if (!pageFrames || !computable || !state.movable) return;
@@ -136,6 +138,7 @@ function loadKernel(s) {
   Promise.all([fetch('api/region/kernel').then((r) => (r.ok ? r.arrayBuffer() : null)), engineLoaded]).then(([buffer]) => {
     if (!buffer || state.held.region !== regionId || state.movable !== movable) return;
     const data = parseKernel(buffer);
+    releaseKernel(kernel?.data);
     kernel = { regionId, data, out: new Float32Array(3 * movable.length) };
     state.marks.kernel.push({ at: performance.now(), bytes: buffer.byteLength });
   }).catch((e) => console.warn(`region kernel: ${e.message}; the server's frames are shown`));
@@ -596,6 +599,21 @@ window.remora = {
   kernelFrame: (transforms, how = 'wasm') => (kernelUsable() ? Array.from(evaluateKernel(kernel.data, transforms, new Float32Array(kernel.out.length), how)) : null),
   /// The engine of the page's frames: 'wasm' (kernel.wasm) or 'js'.
   kernelEngine: () => (kernelUsable() && kernel.data.wasm ? 'wasm' : engine()),
+  /// Median milliseconds of the page's frame under `transforms` per engine ('wasm', 'wasm1': one
+  /// thread, 'js'), over `n` frames of each, interleaved; null before the region's kernel is here.
+  kernelTimes(transforms, engines, n) {
+    if (!kernelUsable()) return null;
+    const out = new Float32Array(kernel.out.length), times = Object.fromEntries(engines.map((e) => [e, []]));
+    for (let i = 0; i < n; ++i)
+      for (const e of engines) {
+        const t0 = performance.now();
+        evaluateKernel(kernel.data, transforms, out, e);
+        times[e].push(performance.now() - t0);
+      }
+    return Object.fromEntries(engines.map((e) => [e, times[e].sort((a, b) => a - b)[n >> 1]]));
+  },
+  /// The threads of the page's frames: 2 once the worker of the region's kernel is ready.
+  kernelThreads: () => (kernelUsable() ? kernel.data.wasm?.threads.threads ?? 1 : 0),
   movableHeld: () => Array.from(state.movable ?? []),
   indicesHeld: () => state.indices,
   tool: () => state.tool,

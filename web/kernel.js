@@ -8,9 +8,11 @@
 //
 // Two engines give the same numbers (bit for bit: the same operations in the same order, in
 // double precision): kernel.wasm, the library's own replay (src/remora/multires/frame_replay.h)
-// compiled to WebAssembly by scripts/build_web.sh, about twice as fast; and the JavaScript
-// below, used when the page was built without it (no clang or wasm-ld) and for the steps the
-// library's replay leaves to its caller (blended motions' step 1).
+// compiled to WebAssembly by scripts/build_web.sh, each step split over two threads
+// (web/engine.js); and the JavaScript below, used when the page has no kernel.wasm and for the
+// step the library's replay leaves to its caller (blended motions' step 1).
+
+import { FrameThreads, wasmLayout } from './engine.js';
 
 const HEADER_WORDS = 16;
 
@@ -73,66 +75,42 @@ export function parseKernel(buffer) {
       for (let c = 0; c < 3; ++c) o[c] += k.rest[6 * k.handleLocal[i] + c] / count;
     k.pivots.push(o);
   }
-  if (wasmModule) attachWasm(k);
+  const layout = wasmLayout();
+  if (layout) attachWasm(k, layout);
   return k;
 }
 
-// ---- the WebAssembly engine ---------------------------------------------------------------------
-let wasmModule = null;
-
-/// Compiles the page's kernel.wasm once (its URL relative to the page); without it (a build with
-/// no WebAssembly tools, or a failed fetch) the frames are evaluated in JavaScript. Resolves to
-/// the engine the next kernels use: 'wasm' or 'js'.
-export async function loadEngine(url = 'kernel.wasm') {
-  try {
-    const response = await fetch(url);
-    if (!response.ok) throw new Error(`${url}: ${response.status}`);
-    wasmModule = await WebAssembly.compile(await response.arrayBuffer());
-  } catch (e) {
-    wasmModule = null;
-    console.info(`the page's frames run in JavaScript (${e.message})`);
-  }
-  return engine();
-}
-export const engine = () => (wasmModule ? 'wasm' : 'js');
-/// The compiled kernel.wasm, or null (web/normals.js's wasmNormals() instantiates it too).
-export const wasmEngine = () => wasmModule;
-
-/// Copies the kernel's arrays into the memory of a new instance of kernel.wasm (one per region:
-/// its memory goes with the kernel) and lays out struct FrameReplay (frame_replay.h: 24 words of
-/// 4 bytes) over them. k.xn becomes the instance's working rows, so that the JavaScript steps
-/// (blended motions) write where the WebAssembly ones read.
-function attachWasm(k) {
-  const instance = new WebAssembly.Instance(wasmModule, {});
-  const w = instance.exports;
-  let at = w.__heap_base.value;
+/// Copies the kernel's arrays into the memory of a new instance of kernel.wasm (web/engine.js; one
+/// per region: its memory goes with the kernel) and lays out struct FrameReplay (frame_replay.h:
+/// 24 words of 4 bytes) over them. k.xn becomes the instance's working rows, so that the
+/// JavaScript steps (blended motions) write where the WebAssembly ones read.
+function attachWasm(k, layout) {
   const sections = [];
-  const reserve = (bytes) => {
-    at = (at + 7) & ~7;
-    at += bytes;
-    return at - bytes;
-  };
   const place = (array) => {
     if (!array) return 0; // a null pointer: no offsets
-    const offset = reserve(array.BYTES_PER_ELEMENT * array.length);
+    const offset = layout.reserve(array.BYTES_PER_ELEMENT * array.length);
     sections.push([offset, array]);
     return offset;
   };
   const arrays = [k.rest, k.freeLocal, k.basis, k.handleBegin, k.handleLocal, k.faces, k.normalVertices, k.ringBegin,
     k.ring, k.recordFace, k.recordSlot, k.recordBary, k.recordOffset, k.recordResidual, k.residuals, k.offsets];
   const pointers = arrays.map(place);
-  const x = reserve(8 * 6 * k.local), cross = reserve(8 * 3 * k.ringFaces);
-  const transforms = reserve(8 * 12 * k.handles), out = reserve(4 * 3 * k.slots), struct = reserve(4 * 24);
-  const grow = Math.ceil((at - w.memory.buffer.byteLength) / 65536);
-  if (grow > 0) w.memory.grow(grow);
-  const memory = w.memory.buffer;
+  const x = layout.reserve(8 * 6 * k.local), cross = layout.reserve(8 * 3 * k.ringFaces);
+  const transforms = layout.reserve(8 * 12 * k.handles), out = layout.reserve(4 * 3 * k.slots);
+  const struct = layout.reserve(4 * 24), control = layout.reserve(16);
+  const instance = layout.instantiate(), memory = instance.buffer;
   for (const [offset, array] of sections) new array.constructor(memory, offset, array.length).set(array);
   new Uint32Array(memory, struct, 24).set([k.handles, k.rows, k.columns, k.normalVertices.length, k.records,
     k.ringFaces, ...pointers, x, cross]);
   k.xn = new Float64Array(memory, x, 6 * k.local);
   k.xn.set(k.rest);
-  k.wasm = { exports: w, struct, transforms, out, maps: new Float64Array(memory, transforms, 12 * k.handles),
-             result: new Float32Array(memory, out, 3 * k.slots) };
+  k.wasm = { threads: new FrameThreads(instance, struct, transforms, out, control),
+             maps: new Float64Array(memory, transforms, 12 * k.handles), result: new Float32Array(memory, out, 3 * k.slots) };
+}
+
+/// Ends what a kernel holds beyond its arrays (the worker of its frames).
+export function releaseKernel(k) {
+  k?.wasm?.threads.stop();
 }
 
 /// Puts the records in the order of their faces' first corners. The server sends them in the
@@ -159,18 +137,18 @@ function sortRecords(k) {
 /// Positions (x, y, z per slot, the order of the region's movable vertices) into `out`
 /// (Float32Array, 3 per movable vertex) under `transforms`: per handle the 12 numbers of the rows
 /// of [M | t] (identity for a missing one).
-/// `engine`: 'wasm' (when the kernel has it) or 'js', for the test that compares them.
+/// `engine`: 'wasm' (when the kernel has it), 'wasm1' (the same on one thread) or 'js', for the
+/// test and the benchmark that compare them.
 export function evaluateKernel(k, transforms, out, engine = 'wasm') {
-  if (k.wasm && engine === 'wasm') {
-    const w = k.wasm;
-    if (k.blended) {
-      blendMotions(k, transforms);
-      w.exports.frame_after_blend(w.struct, w.out);
-    } else {
-      for (let j = 0; j < k.handles; ++j) w.maps.set(transforms[j] ?? IDENTITY, 12 * j);
-      w.exports.frame_linear(w.struct, w.transforms, w.out);
+  if (k.wasm && engine.startsWith('wasm')) {
+    const { threads, maps, result } = k.wasm, single = engine === 'wasm1';
+    if (k.blended) blendMotions(k, transforms);
+    else {
+      for (let j = 0; j < k.handles; ++j) maps.set(transforms[j] ?? IDENTITY, 12 * j);
+      threads.run(0, single);
     }
-    out.set(w.result.length <= out.length ? w.result : w.result.subarray(0, out.length));
+    for (const step of [1, 2, 3]) threads.run(step, single);
+    out.set(result.length <= out.length ? result : result.subarray(0, out.length));
     return out;
   }
   if (k.blended) blendMotions(k, transforms);

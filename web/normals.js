@@ -4,6 +4,7 @@
 // vertex can change it. web/tests/e2e.mjs checks the result against computeVertexNormals().
 // Where the page has kernel.wasm, wasmNormals() computes the same sums there (display_normals()
 // in web/wasm/kernel.cpp), in double precision.
+import { wasmLayout } from './engine.js';
 
 /// The faces around each vertex, built once per mesh: faces(v) are the face offsets (3 f) in
 /// faces[begin[v] .. begin[v + 1]). indices: Uint32 triples.
@@ -72,12 +73,14 @@ export function updateNormals(positions, indices, normals, plan) {
   }
 }
 
-/// The plan's normals in an instance of kernel.wasm (`module`), for the frames of one region:
+/// The plan's normals in an instance of kernel.wasm (web/engine.js), for the frames of one region:
 /// update(positions, moved) takes the drawn positions (the moved vertices already written) and
 /// `moved` (x, y, z per movable vertex, in the order of `movable`) and writes the plan's normals
 /// into `normals`, as updateNormals() does. `map`: the drawn vertex's mesh vertex (crease copies),
-/// or null; meshVertices: the mesh's vertex count.
-export function wasmNormals(module, indices, plan, movable, map, meshVertices) {
+/// or null; meshVertices: the mesh's vertex count. Null without kernel.wasm.
+export function wasmNormals(indices, plan, movable, map, meshVertices) {
+  const layout = wasmLayout();
+  if (!layout) return null;
   const drawn = plan.affected.length;
   // Where each drawn corner's position is: the slot of its mesh vertex among the moved ones, or
   // one of the constant positions (corners that do not move), gathered each frame.
@@ -98,17 +101,11 @@ export function wasmNormals(module, indices, plan, movable, map, meshVertices) {
       corner[3 * f + k] = reference[d];
       toward[3 * f + k] = target[d];
     }
-  const instance = new WebAssembly.Instance(module, {});
-  const w = instance.exports;
-  let at = w.__heap_base.value;
-  const reserve = (bytes) => { at = (at + 7) & ~7; at += bytes; return at - bytes; };
   const vertices = plan.vertices.length, positionCount = movable.length + constants.length;
-  const cornerAt = reserve(4 * corner.length), targetAt = reserve(4 * toward.length);
-  const positionsAt = reserve(12 * positionCount), sumsAt = reserve(24 * vertices), normalsAt = reserve(12 * vertices);
-  const struct = reserve(4 * 7);
-  const grow = Math.ceil((at - w.memory.buffer.byteLength) / 65536);
-  if (grow > 0) w.memory.grow(grow);
-  const memory = w.memory.buffer;
+  const cornerAt = layout.reserve(4 * corner.length), targetAt = layout.reserve(4 * toward.length);
+  const positionsAt = layout.reserve(12 * positionCount), sumsAt = layout.reserve(24 * vertices);
+  const normalsAt = layout.reserve(12 * vertices), struct = layout.reserve(4 * 7);
+  const instance = layout.instantiate(), w = instance.exports, memory = instance.buffer;
   new Uint32Array(memory, cornerAt, corner.length).set(corner);
   new Int32Array(memory, targetAt, toward.length).set(toward);
   new Uint32Array(memory, struct, 7).set([faces, vertices, cornerAt, targetAt, positionsAt, sumsAt, normalsAt]);

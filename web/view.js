@@ -5,7 +5,6 @@ import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 import { TransformControls } from 'three/addons/controls/TransformControls.js';
 import { normalPlan, updateNormals, vertexFaces, wasmNormals } from './normals.js';
-import { wasmEngine } from './kernel.js';
 import { splitCreases, withCopies } from './creases.js';
 
 export const FIXED = -2, FREE = -1;
@@ -172,8 +171,7 @@ export function setMovable(movable) {
   const ids = movable && display ? withCopies(movable, display.copies) : movable;
   plan = ids ? normalPlan(g.getIndex().array, around, ids) : null;
   movedCopies = ids && display ? ids.slice(movable.length) : [];
-  const module = wasmEngine();
-  planInWasm = plan && module ? wasmNormals(module, g.getIndex().array, plan, movable, display?.map ?? null, meshPositions.length / 3) : null;
+  planInWasm = plan ? wasmNormals(g.getIndex().array, plan, movable, display?.map ?? null, meshPositions.length / 3) : null;
 }
 
 export const normalsEngine = () => (planInWasm ? 'wasm' : 'js');

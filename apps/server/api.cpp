@@ -162,7 +162,7 @@ HttpResponse transform(Session& session, const HttpRequest& request, const ApiLi
         throw BadRequest(fmt::format("matrix[{}]: expected a finite number", 4 * r + c));
       t(r, c) = x.get<double>();
     }
-  HttpResponse r = frame_response(session.set_transform(j.at("handle").get<int>(), t));
+  HttpResponse r = frame_response(session.set_transform(j.at("handle").get<int>(), t, positions));
   if (!positions) {
     r.status = 204;
     r.body.clear();

@@ -58,6 +58,10 @@ void bind_http(httplib::Server& http, Session& session, const ApiLimits& limits,
     res.status = r.status;
     for (const auto& [key, value] : r.headers) res.set_header(key, value);
     res.set_header("Cache-Control", "no-store");
+    // Cross-origin isolation, so that the page may share memory with a worker (its frames on
+    // both cores: web/kernel.js); everything it loads comes from here.
+    res.set_header("Cross-Origin-Opener-Policy", "same-origin");
+    res.set_header("Cross-Origin-Embedder-Policy", "require-corp");
     res.set_content(r.body, r.content_type.c_str());
   };
   http.Get(".*", adapt);

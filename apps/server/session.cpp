@@ -109,6 +109,8 @@ struct Session::Impl {
   std::vector<Snapshot> history;
   std::size_t cursor = 0; // history[cursor] is the applied snapshot
   double last_frame_ms = 0.0;
+  /// The shape lags the editor: a move went unanswered (set_transform without an answer).
+  bool shape_behind = false;
   std::shared_ptr<Shape> shape; // what the page shows and paints on
   // Change counters (status): the faces (a load), the positions other than through a frame of
   // set_transform (load, undo, redo, a new k under moved handles), the region.
@@ -154,6 +156,7 @@ struct Session::Impl {
     for (std::size_t j = 0; j < transforms.size(); ++j)
       box->editor.set_transform(static_cast<int>(j), transforms[j]);
     shape->set_positions(region ? box->editor.positions() : positions_matrix(box->editor.input()));
+    shape_behind = false;
     ++positions_id;
   }
   /// The job's progress: `phase` at `s` of `n` steps; its fraction of the whole job from the
@@ -295,6 +298,7 @@ struct Session::Impl {
       for (std::size_t j = 0; j < moved_by.size(); ++j)
         box->editor.set_transform(static_cast<int>(j), moved_by[j]);
       shape->set_positions(box->editor.positions());
+      shape_behind = false;
       ++positions_id;
     } else {
       transforms.assign(key.handles.size(), identity_transform());
@@ -312,6 +316,7 @@ struct Session::Impl {
     f.iterations = editor.report().method == "nonlinear" ? editor.report().nonlinear.iterations : 0;
     f.ms = last_frame_ms = ms_since(t0);
     shape->set_positions(editor.movable_vertices(), p);
+    shape_behind = false;
     return f;
   }
   /// report() under the lock, then the options' own progress callback without it. On the worker.
@@ -423,13 +428,17 @@ void Session::start_region(std::vector<int> support, std::vector<std::vector<int
   });
 }
 
-Frame Session::set_transform(int handle, const Transform& transform) {
+Frame Session::set_transform(int handle, const Transform& transform, bool answer) {
   std::lock_guard lock(impl_->mutex);
   Impl& m = *impl_;
   m.require_region();
   m.box->editor.set_transform(handle, transform); // validates
   m.transforms[static_cast<std::size_t>(handle)] = transform;
-  return m.frame(m.options.frame_budget_ms);
+  if (answer) return m.frame(m.options.frame_budget_ms);
+  m.shape_behind = true;
+  Frame f;
+  f.ms = m.last_frame_ms;
+  return f;
 }
 
 Frame Session::relax(double budget_ms) {
@@ -626,7 +635,9 @@ Pick Session::pick(const Vec3& origin, const Vec3& direction, double radius, Bru
                    std::int64_t stroke) {
   std::lock_guard lock(impl_->mutex);
   if (!impl_->shape) throw Busy("no mesh is loaded yet: load one first");
-  return impl_->shape->pick(origin, direction, radius, brush, stroke);
+  Impl& m = *impl_;
+  if (m.shape_behind && m.region) m.frame(m.options.frame_budget_ms);
+  return m.shape->pick(origin, direction, radius, brush, stroke);
 }
 
 std::string Session::name() const {

@@ -93,8 +93,11 @@ public:
   void wait_for(std::chrono::milliseconds timeout);
 
   /// Moves handle j (live: not in the history until commit()). Returns the positions of
-  /// movable_vertices(), in that order. Method nonlinear iterates for frame_budget_ms.
-  Frame set_transform(int handle, const Transform& transform);
+  /// movable_vertices(), in that order. Method nonlinear iterates for frame_budget_ms. With
+  /// `answer` false nothing is computed now (a client that evaluates its own frames: the page)
+  /// and the Frame holds no positions; the frame is computed when something reads the shape
+  /// (a pick, the positions, an export, the next answered move).
+  Frame set_transform(int handle, const Transform& transform, bool answer = true);
   /// Method nonlinear: iterates for at most `budget_ms` more under the live transforms (the
   /// page calls it while the user pauses, until converged). Method linear: the positions as
   /// they are, converged.

@@ -20,7 +20,9 @@
 //                        kernel, and kernel_after_mouseup_ms, its arrival after the handle stroke's
 //                        mouse-up (compare mouseup_to_gizmo_ms);
 //   bytes_per_frame      the transform answer's size; support_vertices, the region's support;
-//   kernel_engine        'wasm' (kernel.wasm) or 'js' (--kernel js, or a page built without it).
+//   kernel_engine        'wasm' (kernel.wasm) or 'js' (--kernel js, or a page built without it);
+//                        kernel_ms_by_engine, the page's frame alone per engine (wasm on two
+//                        threads, wasm1 on one, js), medians of 31 each, interleaved.
 // The pointer moves one step per 1/60 s (a browser delivers moves once per display frame). All
 // medians. The last line printed is one JSON object with these keys.
 //
@@ -134,6 +136,8 @@ try {
     kernel_after_mouseup_ms: round(kernelMark ? kernelMark.at - afterKernel.strokeEnd : null),
     kernel_bytes: kernelMark?.bytes ?? null,
     kernel_engine: await page.evaluate(() => window.remora.kernelEngine()),
+    kernel_ms_by_engine: await page.evaluate(() => window.remora.kernelTimes([[1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 1e-3]],
+                                                                           ['wasm', 'wasm1', 'js'], 31)),
     drag_cycle_shown_ms: round(median(shown.ms)), bake_ms: round(bake),
     bytes_per_frame: median([...shown.bytes, ...hidden.bytes]), support_vertices: support,
     paint_moves: paintMove.length + paintMoveShown.length, drag_frames: hidden.ms.length + shown.ms.length,

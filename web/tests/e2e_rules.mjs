@@ -348,7 +348,10 @@ export async function kernelAgrees(page, c, rest, region, dragged, what = 'the p
   // Both engines: kernel.wasm (the library's replay) where the build has it, and the JavaScript.
   const engine = await page.evaluate(() => window.remora.kernelEngine());
   const wasmBuilt = existsSync(join(args['web-root'] ?? '', 'kernel.wasm'));
-  check(engine === (wasmBuilt ? 'wasm' : 'js'), `${what} runs in ${engine} (kernel.wasm ${wasmBuilt ? '' : 'not '}built)`);
+  const threads = await page.evaluate(() => window.remora.kernelThreads());
+  const cores = await page.evaluate(() => navigator.hardwareConcurrency);
+  check(engine === (wasmBuilt ? 'wasm' : 'js') && (engine === 'js' || threads === Math.min(2, cores)),
+        `${what} runs in ${engine} on ${threads} threads (kernel.wasm ${wasmBuilt ? '' : 'not '}built, ${cores} cores)`);
   const js = await page.evaluate((t) => window.remora.kernelFrame([t], 'js'), rows);
   let apart = js && local && js.length === local.length ? 0 : Infinity;
   for (let i = 0; i < local.length && apart < Infinity; ++i) apart = Math.max(apart, Math.abs(js[i] - local[i]));

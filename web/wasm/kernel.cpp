@@ -25,6 +25,42 @@ frame_after_blend(const remora::FrameReplay* f, float* out) {
   remora::replay_decode(*f, out);
 }
 
+/// Part `part` of `parts` of one step of a linear frame, for a frame split over threads
+/// (web/kernel.js): step 0 the blend (part 0 also moves the handles' vertices), 1 the faces'
+/// cross products, 2 the vertex normals, 3 the decode (a blended-motions frame, whose step 0 is
+/// the caller's, runs 1 to 3). Every part of a step must end before any part of the next begins.
+__attribute__((export_name("frame_part"))) void frame_part(const remora::FrameReplay* f,
+                                                           const double* transforms, float* out,
+                                                           uint32_t step, uint32_t part,
+                                                           uint32_t parts) {
+  const auto range = [&](uint32_t n, uint32_t& begin, uint32_t& end) {
+    begin = uint32_t(uint64_t(n) * part / parts);
+    end = uint32_t(uint64_t(n) * (part + 1) / parts);
+  };
+  uint32_t begin = 0, end = 0;
+  switch (step) {
+  case 0:
+    range(f->rows, begin, end);
+    remora::replay_blend_rows(*f, transforms, begin, end);
+    if (part == 0) remora::replay_move_handles(*f, transforms);
+    break;
+  case 1:
+    range(f->ring_faces, begin, end);
+    remora::replay_face_crosses(*f, begin, end);
+    break;
+  case 2:
+    range(f->normal_count, begin, end);
+    remora::replay_vertex_normals(*f, begin, end);
+    break;
+  case 3:
+    range(f->record_count, begin, end);
+    remora::replay_decode_records(*f, out, begin, end);
+    break;
+  default:
+    break;
+  }
+}
+
 /// The drawn mesh's vertex normals that a drag changes, with three.js's formula (web/normals.js,
 /// updateNormals(): the sum over a vertex's faces of (c − b) × (a − b), normalized; a zero sum
 /// gives (0, 0, 0)). Every field is 4 bytes: web/normals.js writes the struct as 7 words.

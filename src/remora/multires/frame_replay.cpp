@@ -36,10 +36,15 @@ bool face_frame(P3 a, P3 b, P3 c, P3& t1, P3& t2, P3& nf) {
 } // namespace
 
 void replay_blend(const FrameReplay& f, const double* transforms) {
+  replay_blend_rows(f, transforms, 0, f.rows);
+}
+
+void replay_blend_rows(const FrameReplay& f, const double* transforms, uint32_t begin,
+                       uint32_t end) {
   // Basis row i · C, C = [I; M_0ᵀ; t_0ᵀ; ...]: the identity's three columns, then per handle
   // w · [M_j | t_j] rows, summed in the order of the columns.
   const uint32_t columns = f.columns;
-  for (uint32_t i = 0; i < f.rows; ++i) {
+  for (uint32_t i = begin; i < end; ++i) {
     const float* b = f.basis + uint64_t(i) * columns;
     double px = b[0], py = b[1], pz = b[2];
     for (uint32_t j = 0; j < f.handles; ++j) {
@@ -74,15 +79,23 @@ void replay_move_handles(const FrameReplay& f, const double* transforms) {
 }
 
 void replay_normals(const FrameReplay& f) {
+  replay_face_crosses(f, 0, f.ring_faces);
+  replay_vertex_normals(f, 0, f.normal_count);
+}
+
+void replay_face_crosses(const FrameReplay& f, uint32_t begin, uint32_t end) {
   const double* x = f.x;
-  for (uint32_t t = 0; t < f.ring_faces; ++t) {
+  for (uint32_t t = begin; t < end; ++t) {
     const uint32_t* c = f.faces + 3 * uint64_t(t);
     const P3 p0 = row(x, c[0]), n = cross(row(x, c[1]) - p0, row(x, c[2]) - p0);
     f.cross[3 * t] = n.x;
     f.cross[3 * t + 1] = n.y;
     f.cross[3 * t + 2] = n.z;
   }
-  for (uint32_t i = 0; i < f.normal_count; ++i) {
+}
+
+void replay_vertex_normals(const FrameReplay& f, uint32_t begin, uint32_t end) {
+  for (uint32_t i = begin; i < end; ++i) {
     double sx = 0.0, sy = 0.0, sz = 0.0;
     for (uint32_t r = f.ring_begin[i]; r < f.ring_begin[i + 1]; ++r) {
       const double* s = f.cross + 3 * uint64_t(f.ring[r]);
@@ -100,8 +113,12 @@ void replay_normals(const FrameReplay& f) {
 }
 
 void replay_decode(const FrameReplay& f, float* out) {
+  replay_decode_records(f, out, 0, f.record_count);
+}
+
+void replay_decode_records(const FrameReplay& f, float* out, uint32_t begin, uint32_t end) {
   const double* x = f.x;
-  for (uint32_t r = 0; r < f.record_count; ++r) {
+  for (uint32_t r = begin; r < end; ++r) {
     const uint32_t* c = f.faces + 3 * uint64_t(f.record_face[r]);
     const double* a = x + 6 * uint64_t(c[0]);
     const double* b = x + 6 * uint64_t(c[1]);

@@ -62,4 +62,14 @@ void replay_normals(const FrameReplay& f);
 /// into out[3 record_slot[r] ..] (single precision).
 void replay_decode(const FrameReplay& f, float* out);
 
+/// The same steps over a range [begin, end), for callers that split a frame over threads (the
+/// page: web/kernel.js). Each writes only its range's rows or records; the ranges of one step
+/// may run at once, and a step must wait for the whole of the step before it (the vertex
+/// normals read every face's cross product).
+void replay_blend_rows(const FrameReplay& f, const double* transforms, uint32_t begin,
+                       uint32_t end);
+void replay_face_crosses(const FrameReplay& f, uint32_t begin, uint32_t end);
+void replay_vertex_normals(const FrameReplay& f, uint32_t begin, uint32_t end);
+void replay_decode_records(const FrameReplay& f, float* out, uint32_t begin, uint32_t end);
+
 } // namespace remora

@@ -1,0 +1,21 @@
+// The second thread of the page's frames (web/engine.js, FrameThreads): an instance of
+// kernel.wasm on the region's shared memory that evaluates part 1 of 2 of each step the page
+// asks for, until the page asks for step −1 or ends the worker.
+onmessage = ({ data }) => {
+  const { module, memory, struct, transforms, out, control } = data;
+  const w = new WebAssembly.Instance(module, { env: { memory } }).exports;
+  const c = new Int32Array(memory.buffer, control, 4);
+  let seen = Atomics.load(c, 0);
+  postMessage('ready');
+  for (;;) {
+    // The steps of a frame follow each other within microseconds: look for the next one for a
+    // moment before sleeping (a wake-up costs more than that).
+    for (let spins = 0; spins < 4096 && Atomics.load(c, 0) === seen; ++spins);
+    Atomics.wait(c, 0, seen); // returns at once when the page has already asked
+    seen = Atomics.load(c, 0);
+    const step = Atomics.load(c, 1);
+    if (step < 0) return;
+    w.frame_part(struct, transforms, out, step, 1, 2);
+    Atomics.store(c, 2, seen);
+  }
+};
