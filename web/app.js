@@ -585,6 +585,16 @@ window.remora = {
     return best;
   },
   setRadius: (r) => panels.setRadius(r),
+  /// The benchmark's largest supports: the `count` vertices nearest the camera painted as
+  /// support (a stroke reaches only the side in view).
+  supportNearest(count) {
+    const p = state.positions, c = view.camera.position, n = p.length / 3, d = new Float64Array(n);
+    for (let v = 0; v < n; ++v) d[v] = (p[3 * v] - c.x) ** 2 + (p[3 * v + 1] - c.y) ** 2 + (p[3 * v + 2] - c.z) ** 2;
+    const order = Uint32Array.from({ length: n }, (_, i) => i).sort((a, b) => d[a] - d[b]);
+    for (let i = 0; i < Math.min(count, n); ++i) state.labels[order[i]] = FREE;
+    state.dirtyRegion = true;
+    view.colour(state.labels);
+  },
   radius: () => panels.radius(),
   pivot: () => pivot.position.toArray(),
   camera: () => view.camera.position.toArray(),

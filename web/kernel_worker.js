@@ -1,6 +1,8 @@
 // The second thread of the page's frames (web/engine.js, FrameThreads): an instance of
 // kernel.wasm on the region's shared memory that evaluates part 1 of 2 of each step the page
 // asks for, until the page asks for step −1 or ends the worker.
+const SPIN_MS = 20;
+
 onmessage = ({ data }) => {
   const { module, memory, struct, transforms, out, control } = data;
   const w = new WebAssembly.Instance(module, { env: { memory } }).exports;
@@ -8,9 +10,12 @@ onmessage = ({ data }) => {
   let seen = Atomics.load(c, 0);
   postMessage('ready');
   for (;;) {
-    // The steps of a frame follow each other within microseconds: look for the next one for a
-    // moment before sleeping (a wake-up costs more than that).
-    for (let spins = 0; spins < 4096 && Atomics.load(c, 0) === seen; ++spins);
+    // The steps of a frame follow each other within microseconds, and a drag's frames come
+    // every display frame: look for the next step for up to SPIN_MS before sleeping (waking up
+    // costs from tens of microseconds to milliseconds when another process holds the core).
+    const start = performance.now();
+    for (let spins = 1; Atomics.load(c, 0) === seen; ++spins)
+      if ((spins & 1023) === 0 && performance.now() - start > SPIN_MS) break;
     Atomics.wait(c, 0, seen); // returns at once when the page has already asked
     seen = Atomics.load(c, 0);
     const step = Atomics.load(c, 1);

@@ -28,11 +28,13 @@
 //
 //   node web/tests/bench.mjs --cli build/bin/remora --web-root build/web [--mesh data/bunny.ply]
 //        [--support-radius R] [--moves N] [--method linear|nonlinear|blended-motions] [--quick]
-//        [--server-frames] [--kernel js]
+//        [--server-frames] [--kernel js] [--sphere-brush] [--support-count N]
 // R is in the mesh's units (default: a fifth of its bounding radius); the support is painted at
 // the surface under the view's centre. --method: the page's method switch, set before the support
 // is painted (default linear). --quick: no drawn figures and no bake (their keys are
-// null). Exit code 0: done, 1: failed, 77: chromium or playwright-core missing.
+// null). --sphere-brush: the brushes take the straight-line distance (the far side too: the
+// largest supports). --support-count N: instead of the support's strokes, the N vertices
+// nearest the camera (no paint figures). Exit code 0: done, 1: failed, 77: chromium or playwright-core missing.
 import { args, chromiumOrSkip, client, drag, ready, startServer } from './harness.mjs';
 
 const moves = Number(args.moves ?? 30);
@@ -63,6 +65,7 @@ try {
   const supportRadius = Number(args['support-radius'] ?? bound / 5);
 
   // The support: strokes of `moves` pointer moves with the large brush, the mesh hidden, then shown.
+  if ('sphere-brush' in args) await page.uncheck('#geodesic');
   await page.keyboard.press('s');
   await page.evaluate((r) => window.remora.setRadius(r), supportRadius);
   const paintStroke = async (dy) => {
@@ -73,9 +76,11 @@ try {
     return { ms: mm.paintMove.slice(from), trips: mm.paintTrip.slice(from) };
   };
   await page.evaluate(() => window.remora.setDrawing(false));
-  const { ms: paintMove, trips: paintTrips } = await paintStroke(0);
+  const supportCount = Number(args['support-count'] ?? 0);
+  if (supportCount > 0) await page.evaluate((n) => window.remora.supportNearest(n), supportCount);
+  const { ms: paintMove, trips: paintTrips } = supportCount > 0 ? { ms: [], trips: [] } : await paintStroke(0);
   await page.evaluate(() => window.remora.setDrawing(true));
-  const { ms: paintMoveShown } = quick ? { ms: [] } : await paintStroke(4);
+  const { ms: paintMoveShown } = quick || supportCount > 0 ? { ms: [] } : await paintStroke(4);
   // The handle inside it, smaller; its mouse-up sends the region.
   await page.keyboard.press('h');
   await page.evaluate((r) => window.remora.setRadius(r / 4), supportRadius);
