@@ -1,7 +1,7 @@
 // The second thread of the page's frames (web/engine.js, FrameThreads): an instance of
 // kernel.wasm on the region's shared memory that evaluates part 1 of 2 of each step the page
 // asks for, until the page asks for step −1 or ends the worker.
-const SPIN_MS = 20;
+const SPIN_MS = 100;
 
 onmessage = ({ data }) => {
   const { module, memory, struct, transforms, out, control } = data;
