@@ -63,10 +63,12 @@ cp "$web/node_modules/three/LICENSE" "$out/three/LICENSE"
 # compiler from calling a memset that none provides), the memory laid out by kernel.js.
 wasm_tools() { command -v "${CLANGXX:-clang++}" >/dev/null && command -v wasm-ld >/dev/null; }
 if wasm_tools; then
-  # Shared memory (atomics, imported): the page's frames run on two threads (web/engine.js).
-  "${CLANGXX:-clang++}" --target=wasm32 -std=c++20 -O3 -msimd128 -matomics -mbulk-memory -nostdlib \
+  # Shared memory (atomics, imported): the page's frames run on two threads (web/engine.js); the
+  # stack pointer exported so that the worker's instance gets a stack of its own.
+  "${CLANGXX:-clang++}" --target=wasm32 -std=c++20 -O3 -msimd128 -matomics -mbulk-memory -mmutable-globals -nostdlib \
     -fno-builtin -fno-exceptions -fno-rtti -Wall -Wextra -Werror -I"$here/src" -Wl,--no-entry \
-    -Wl,--export=__heap_base -Wl,--shared-memory -Wl,--import-memory -Wl,--max-memory=4294967296 \
+    -Wl,--export=__heap_base -Wl,--export=__stack_pointer -Wl,--shared-memory -Wl,--import-memory \
+    -Wl,--max-memory=4294967296 \
     -o "$out/kernel.wasm.tmp" "$web/wasm/kernel.cpp" "$here/src/remora/multires/frame_replay.cpp"
   mv "$out/kernel.wasm.tmp" "$out/kernel.wasm"
 else

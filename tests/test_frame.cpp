@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <random>
 #include <set>
 
@@ -277,10 +278,11 @@ TEST(FrameExport, ReplayedInSinglePrecisionGivesTheEditorsPositions) {
 
 // The library's client replay (frame_replay.h), which the page runs as WebAssembly, over an
 // export: a linear frame, x, y, z per movable vertex in single precision (NaN where no record
-// wrote).
+// wrote). With `parts` > 1 each step runs over that many ranges, one after the other, as the
+// page's threads split it.
 std::vector<float> replay_with_library(const FrameExport& f,
                                        const std::vector<Transform>& transforms,
-                                       std::size_t movable) {
+                                       std::size_t movable, std::uint32_t parts = 1) {
   FrameReplay r;
   r.handles = std::uint32_t(f.handles);
   r.rows = std::uint32_t(f.free_local.size());
@@ -312,40 +314,70 @@ std::vector<float> replay_with_library(const FrameExport& f,
     for (int row = 0; row < 3; ++row)
       for (int col = 0; col < 4; ++col) maps.push_back(t(row, col));
   std::vector<float> out(3 * movable, std::nanf(""));
-  replay_blend(r, maps.data());
+  if (parts == 1) {
+    replay_blend(r, maps.data());
+    replay_move_handles(r, maps.data());
+    replay_normals(r);
+    replay_decode(r, out.data());
+    return out;
+  }
+  const auto split = [parts](std::uint32_t n, std::uint32_t p) {
+    return std::pair{std::uint32_t(std::uint64_t(n) * p / parts),
+                     std::uint32_t(std::uint64_t(n) * (p + 1) / parts)};
+  };
+  for (std::uint32_t p = 0; p < parts; ++p) {
+    const auto [b, e] = split(r.rows, p);
+    replay_blend_rows(r, maps.data(), b, e);
+  }
   replay_move_handles(r, maps.data());
-  replay_normals(r);
-  replay_decode(r, out.data());
+  for (std::uint32_t p = 0; p < parts; ++p) {
+    const auto [b, e] = split(r.ring_faces, p);
+    replay_face_crosses(r, b, e);
+  }
+  for (std::uint32_t p = 0; p < parts; ++p) {
+    const auto [b, e] = split(r.normal_count, p);
+    replay_vertex_normals(r, b, e);
+  }
+  for (std::uint32_t p = 0; p < parts; ++p) {
+    const auto [b, e] = split(r.record_count, p);
+    replay_decode_records(r, out.data(), b, e);
+  }
   return out;
 }
 
 TEST(FrameReplay, TheLibrarysReplayGivesTheEditorsPositionsAndTheTestsReplay) {
-  for_each_export_case(
-      [](Editor& editor, const std::vector<Transform>& transforms, DetailMode mode) {
-        const FrameExport f = frame_export(editor);
-        const std::vector<int>& movable = editor.movable_vertices();
-        const std::vector<float> library = replay_with_library(f, transforms, movable.size());
-        const Eigen::MatrixXd tests = replay_export(f, transforms, movable.size());
-        const Eigen::MatrixXd& p = editor.positions();
-        double to_editor = 0.0, to_test = 0.0;
-        for (std::size_t i = 0; i < movable.size(); ++i)
-          for (int c = 0; c < 3; ++c) {
-            const double q = library[3 * i + std::size_t(c)];
-            ASSERT_TRUE(std::isfinite(q)) << "movable vertex " << i << " not written";
-            to_editor = std::max(to_editor, std::abs(q - p(movable[i], c)));
-            to_test = std::max(to_test, std::abs(q - tests(Eigen::Index(i), c)));
-          }
-        EXPECT_LT(to_editor, 1e-5) << "detail mode " << int(mode); // the sphere's diagonal is 3.5
-        // The same arithmetic in double precision, rounded to single once at the end.
-        EXPECT_LT(to_test, 1e-6) << "detail mode " << int(mode);
-        // A map that the replay does not apply is seen: the identity's frame is far from it.
-        const std::vector<float> rest =
-            replay_with_library(f, {Transform::Identity(), Transform::Identity()}, movable.size());
-        double apart = 0.0;
-        for (std::size_t i = 0; i < rest.size(); ++i)
-          apart = std::max(apart, std::abs(double(rest[i]) - double(library[i])));
-        EXPECT_GT(apart, 0.1);
-      });
+  for_each_export_case([](Editor& editor, const std::vector<Transform>& transforms,
+                          DetailMode mode) {
+    const FrameExport f = frame_export(editor);
+    const std::vector<int>& movable = editor.movable_vertices();
+    const std::vector<float> library = replay_with_library(f, transforms, movable.size());
+    const Eigen::MatrixXd tests = replay_export(f, transforms, movable.size());
+    const Eigen::MatrixXd& p = editor.positions();
+    double to_editor = 0.0, to_test = 0.0;
+    for (std::size_t i = 0; i < movable.size(); ++i)
+      for (int c = 0; c < 3; ++c) {
+        const double q = library[3 * i + std::size_t(c)];
+        ASSERT_TRUE(std::isfinite(q)) << "movable vertex " << i << " not written";
+        to_editor = std::max(to_editor, std::abs(q - p(movable[i], c)));
+        to_test = std::max(to_test, std::abs(q - tests(Eigen::Index(i), c)));
+      }
+    EXPECT_LT(to_editor, 1e-5) << "detail mode " << int(mode); // the sphere's diagonal is 3.5
+    // The same arithmetic in double precision, rounded to single once at the end.
+    EXPECT_LT(to_test, 1e-6) << "detail mode " << int(mode);
+    // Split over ranges (the page's two threads, or three), the same bits.
+    for (const std::uint32_t parts : {2u, 3u}) {
+      const std::vector<float> split = replay_with_library(f, transforms, movable.size(), parts);
+      EXPECT_EQ(std::memcmp(split.data(), library.data(), split.size() * sizeof(float)), 0)
+          << parts << " parts";
+    }
+    // A map that the replay does not apply is seen: the identity's frame is far from it.
+    const std::vector<float> rest =
+        replay_with_library(f, {Transform::Identity(), Transform::Identity()}, movable.size());
+    double apart = 0.0;
+    for (std::size_t i = 0; i < rest.size(); ++i)
+      apart = std::max(apart, std::abs(double(rest[i]) - double(library[i])));
+    EXPECT_GT(apart, 0.1);
+  });
 }
 
 } // namespace

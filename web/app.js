@@ -154,6 +154,7 @@ function localFrame(t0) {
   if (!kernelUsable()) return false;
   evaluateKernel(kernel.data, transformRows(), kernel.out);
   const evaluated = performance.now();
+  state.frameMs = evaluated - t0;
   view.applyMoved(state.movable, kernel.out);
   const done = performance.now();
   state.marks.drag.push(done - t0);
@@ -423,7 +424,7 @@ async function sendFrame(request) {
 }
 let lastMove = 0, relaxTimer = null;
 const frames = new Coalescer(sendFrame, (result, request) => {
-  if (request.local) { state.frameMs = result.ms; return; } // shown by localFrame()
+  if (request.local) return; // shown by localFrame(), which also timed it
   if (!state.movable || result.moved.length !== 3 * state.movable.length) return;
   state.frameMs = result.ms;
   const received = performance.now();

@@ -53,9 +53,11 @@ export function wasmLayout() {
 /// frame_part() (web/wasm/kernel.cpp) while the worker evaluates the other, and returns when both
 /// are done; until the worker is ready, or without workers, the page evaluates the whole step.
 /// `control`: 16 bytes reserved in the instance's memory for the handshake (Int32: the step's
-/// number, the step, the number of the step the worker finished).
+/// number, the step, the number of the step the worker finished); `stackTop`: the end of an
+/// area reserved for the worker's stack (each instance has its own stack pointer, and the page's
+/// stack is the module's own, below __heap_base).
 export class FrameThreads {
-  constructor(instance, struct, transforms, out, control) {
+  constructor(instance, struct, transforms, out, control, stackTop) {
     Object.assign(this, { exports: instance.exports, struct, transforms, out, ready: false, worker: null });
     this.control = new Int32Array(instance.buffer, control, 4);
     if (typeof Worker === 'undefined' || (globalThis.navigator?.hardwareConcurrency ?? 1) < 2) return;
@@ -67,7 +69,7 @@ export class FrameThreads {
     }
     this.worker.onmessage = () => { this.ready = true; };
     this.worker.onerror = (e) => { console.warn(`frame worker: ${e.message}; one thread from now on`); this.stop(); };
-    this.worker.postMessage({ module: wasmModule, memory: instance.memory, struct, transforms, out, control });
+    this.worker.postMessage({ module: wasmModule, memory: instance.memory, struct, transforms, out, control, stackTop });
   }
   get threads() { return this.ready ? 2 : 1; }
   /// `single`: the page's thread alone (the benchmark compares).

@@ -15,6 +15,7 @@
 import { FrameThreads, wasmLayout } from './engine.js';
 
 const HEADER_WORDS = 16;
+const WORKER_STACK = 1 << 16; // the worker instance's stack, in the region's memory
 
 /// The kernel of a region from the bytes of `GET /api/region/kernel` (docs/server.md). Throws
 /// an Error for a buffer whose sections do not add up.
@@ -66,7 +67,6 @@ export function parseKernel(buffer) {
   for (let r = 0; r < records; ++r)
     for (let c = 0; c < 3; ++c) k.recordRows[3 * r + c] = 6 * k.faces[3 * k.recordFace[r] + c];
   k.cross = new Float64Array(3 * ringFaces);
-  k.coefficients = new Float64Array(3 * columns);
   // Blended motions: the handles' pivots, the centroids of their rest positions.
   k.pivots = [];
   for (let j = 0; j < handles; ++j) {
@@ -97,14 +97,14 @@ function attachWasm(k, layout) {
   const pointers = arrays.map(place);
   const x = layout.reserve(8 * 6 * k.local), cross = layout.reserve(8 * 3 * k.ringFaces);
   const transforms = layout.reserve(8 * 12 * k.handles), out = layout.reserve(4 * 3 * k.slots);
-  const struct = layout.reserve(4 * 24), control = layout.reserve(16);
+  const struct = layout.reserve(4 * 24), control = layout.reserve(16), stack = layout.reserve(WORKER_STACK);
   const instance = layout.instantiate(), memory = instance.buffer;
   for (const [offset, array] of sections) new array.constructor(memory, offset, array.length).set(array);
   new Uint32Array(memory, struct, 24).set([k.handles, k.rows, k.columns, k.normalVertices.length, k.records,
     k.ringFaces, ...pointers, x, cross]);
   k.xn = new Float64Array(memory, x, 6 * k.local);
   k.xn.set(k.rest);
-  k.wasm = { threads: new FrameThreads(instance, struct, transforms, out, control),
+  k.wasm = { threads: new FrameThreads(instance, struct, transforms, out, control, stack + WORKER_STACK),
              maps: new Float64Array(memory, transforms, 12 * k.handles), result: new Float32Array(memory, out, 3 * k.slots) };
 }
 
@@ -281,22 +281,22 @@ function inverseTranspose(A) {
   return cof.map((c) => c / det); // the cofactor matrix over det is A⁻ᵀ
 }
 
-/// Step 1: the basis rows times C = [I; M_0ᵀ; t_0ᵀ; ...], and the handles' own vertices moved
-/// rigidly with their maps.
+/// Step 1: the basis rows times C = [I; M_0ᵀ; t_0ᵀ; ...] (the identity's three columns, then
+/// per handle w · the rows of [M_j | t_j], summed in the order of the columns, as
+/// frame_replay.cpp does), and the handles' own vertices moved rigidly with their maps.
 function blend(k, transforms) {
-  const { columns, basis, freeLocal, rows, xn: x, coefficients: C } = k;
-  C.fill(0);
-  C[0] = C[4] = C[8] = 1;
-  for (let j = 0; j < k.handles; ++j) {
-    const t = transforms[j] ?? IDENTITY;
-    for (let c = 0; c < 4; ++c)
-      for (let r = 0; r < 3; ++r) C[3 * (3 + 4 * j + c) + r] = t[4 * r + c];
-  }
+  const { columns, basis, freeLocal, rows, xn: x, handles } = k;
+  const maps = [];
+  for (let j = 0; j < handles; ++j) maps.push(transforms[j] ?? IDENTITY);
   for (let i = 0; i < rows; ++i) {
-    let px = 0, py = 0, pz = 0;
-    for (let c = 0, b = i * columns; c < columns; ++c, ++b) {
-      const w = basis[b];
-      px += w * C[3 * c]; py += w * C[3 * c + 1]; pz += w * C[3 * c + 2];
+    const b = i * columns;
+    let px = basis[b], py = basis[b + 1], pz = basis[b + 2];
+    for (let j = 0; j < handles; ++j) {
+      const t = maps[j], w = b + 3 + 4 * j;
+      for (let c = 0; c < 4; ++c) {
+        const wc = basis[w + c];
+        px += wc * t[c]; py += wc * t[4 + c]; pz += wc * t[8 + c];
+      }
     }
     const v = 6 * freeLocal[i];
     x[v] = px; x[v + 1] = py; x[v + 2] = pz;
@@ -382,7 +382,8 @@ function faceFrame(x, a, b, c) {
   const e1 = [x[b] - x[a], x[b + 1] - x[a + 1], x[b + 2] - x[a + 2]];
   const e2 = [x[c] - x[a], x[c + 1] - x[a + 1], x[c + 2] - x[a + 2]];
   const cr = [e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]];
-  const len = Math.hypot(...e1), area2 = Math.hypot(...cr);
+  const len = Math.sqrt(e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2]);
+  const area2 = Math.sqrt(cr[0] * cr[0] + cr[1] * cr[1] + cr[2] * cr[2]);
   if (!(area2 > 1e-14 * Math.max(len * len, e2[0] * e2[0] + e2[1] * e2[1] + e2[2] * e2[2])) || !(len > 0)) return null;
   const t1 = e1.map((v) => v / len), nf = cr.map((v) => v / area2);
   const t2 = [nf[1] * t1[2] - nf[2] * t1[1], nf[2] * t1[0] - nf[0] * t1[2], nf[0] * t1[1] - nf[1] * t1[0]];

@@ -4,8 +4,9 @@
 const SPIN_MS = 100;
 
 onmessage = ({ data }) => {
-  const { module, memory, struct, transforms, out, control } = data;
+  const { module, memory, struct, transforms, out, control, stackTop } = data;
   const w = new WebAssembly.Instance(module, { env: { memory } }).exports;
+  w.__stack_pointer.value = stackTop; // a stack of its own in the shared memory
   const c = new Int32Array(memory.buffer, control, 4);
   let seen = Atomics.load(c, 0);
   postMessage('ready');

@@ -74,9 +74,10 @@ export function updateNormals(positions, indices, normals, plan) {
 }
 
 /// The plan's normals in an instance of kernel.wasm (web/engine.js), for the frames of one region:
-/// update(positions, moved) takes the drawn positions (the moved vertices already written) and
-/// `moved` (x, y, z per movable vertex, in the order of `movable`) and writes the plan's normals
-/// into `normals`, as updateNormals() does. `map`: the drawn vertex's mesh vertex (crease copies),
+/// update(positions, moved, normals) takes the drawn positions (the moved vertices already
+/// written) and `moved` (x, y, z per vertex of this `movable`, in its order: the caller checks
+/// that its frame is of these vertices) and writes the plan's normals into `normals`, as
+/// updateNormals() does. `map`: the drawn vertex's mesh vertex (crease copies),
 /// or null; meshVertices: the mesh's vertex count. Null without kernel.wasm.
 export function wasmNormals(indices, plan, movable, map, meshVertices) {
   const layout = wasmLayout();
@@ -113,6 +114,7 @@ export function wasmNormals(indices, plan, movable, map, meshVertices) {
   const fixed = new Float32Array(memory, positionsAt + 12 * movable.length, 3 * constants.length);
   const result = new Float32Array(memory, normalsAt, 3 * vertices), still = Uint32Array.from(constants);
   return {
+    movable,
     update(positions, moved, normals) {
       moving.set(moved);
       for (let i = 0; i < still.length; ++i) {

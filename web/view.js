@@ -191,7 +191,9 @@ export function applyMoved(movable, moved) {
     const v = display.map[d];
     p[3 * d] = meshPositions[3 * v]; p[3 * d + 1] = meshPositions[3 * v + 1]; p[3 * d + 2] = meshPositions[3 * v + 2];
   }
-  if (planInWasm) planInWasm.update(p, moved, normal.array);
+  // A frame of the region before (an answer that crossed a new region's plan): the plain sums.
+  if (planInWasm && planInWasm.movable === movable && moved.length === 3 * movable.length)
+    planInWasm.update(p, moved, normal.array);
   else updateNormals(p, g.getIndex().array, normal.array, plan);
   if (plan.last < plan.first) return;
   touch(position, plan.first, plan.last);

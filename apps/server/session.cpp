@@ -302,6 +302,12 @@ struct Session::Impl {
       ++positions_id;
     } else {
       transforms.assign(key.handles.size(), identity_transform());
+      // A move that went unanswered: the shape shows the new base (the baked move) in full,
+      // not only around the new region's movable vertices.
+      if (shape_behind) {
+        shape->set_positions(box->editor.positions());
+        shape_behind = false;
+      }
     }
     push_snapshot();
   }
@@ -372,6 +378,7 @@ void Session::start_load(std::string bytes, std::string name) {
     std::lock_guard guard(m.mutex);
     m.box = box;
     m.shape = std::move(shape);
+    m.shape_behind = false;
     ++m.mesh_id;
     ++m.positions_id;
     ++m.region_id;
@@ -436,9 +443,7 @@ Frame Session::set_transform(int handle, const Transform& transform, bool answer
   m.transforms[static_cast<std::size_t>(handle)] = transform;
   if (answer) return m.frame(m.options.frame_budget_ms);
   m.shape_behind = true;
-  Frame f;
-  f.ms = m.last_frame_ms;
-  return f;
+  return {}; // no positions, no frame time
 }
 
 Frame Session::relax(double budget_ms) {
@@ -636,7 +641,8 @@ Pick Session::pick(const Vec3& origin, const Vec3& direction, double radius, Bru
   std::lock_guard lock(impl_->mutex);
   if (!impl_->shape) throw Busy("no mesh is loaded yet: load one first");
   Impl& m = *impl_;
-  if (m.shape_behind && m.region) m.frame(m.options.frame_budget_ms);
+  // Not while a job holds the editor: its install brings the shape up to date.
+  if (m.shape_behind && m.region && !m.busy) m.frame(m.options.frame_budget_ms);
   return m.shape->pick(origin, direction, radius, brush, stroke);
 }
 

@@ -17,6 +17,8 @@ namespace remora {
 
 /// The arrays of a FrameExport (same names, same shapes) and the frame's working memory. Every
 /// field is 4 bytes on wasm32, in this order: web/kernel.js writes the struct as 24 words.
+/// The caller's out array holds 3 (max record_slot + 1) floats; free_local and handle_local
+/// name different vertices (a thread may move the handles while another blends rows).
 struct FrameReplay {
   uint32_t handles = 0;        ///< h
   uint32_t rows = 0;           ///< basis rows (free base vertices)
