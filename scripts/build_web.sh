@@ -8,8 +8,8 @@
 #
 # kernel.wasm, the page's frames (web/wasm/kernel.cpp and the library's
 # src/remora/multires/frame_replay.cpp for wasm32), is built with clang++ and wasm-ld (Debian's
-# clang and lld); without them the page evaluates its frames in JavaScript, about half as fast,
-# and this says so.
+# clang and lld); without them the page evaluates its frames in JavaScript, slower
+# (docs/server.md), and this says so.
 #
 # The registry is reached over the network, which fails now and then, and npm by default waits 5
 # minutes on a silent connection: here npm gives up on one after 60 s and retries each request
@@ -65,10 +65,10 @@ wasm_tools() { command -v "${CLANGXX:-clang++}" >/dev/null && command -v wasm-ld
 if wasm_tools; then
   # Shared memory (atomics, imported): the page's frames run on two threads (web/engine.js); the
   # stack pointer exported so that the worker's instance gets a stack of its own.
-  "${CLANGXX:-clang++}" --target=wasm32 -std=c++20 -O3 -msimd128 -matomics -mbulk-memory -mmutable-globals -nostdlib \
-    -fno-builtin -fno-exceptions -fno-rtti -Wall -Wextra -Werror -I"$here/src" -Wl,--no-entry \
-    -Wl,--export=__heap_base -Wl,--export=__stack_pointer -Wl,--shared-memory -Wl,--import-memory \
-    -Wl,--max-memory=4294967296 \
+  "${CLANGXX:-clang++}" --target=wasm32 -std=c++20 -O3 -msimd128 -matomics -mbulk-memory \
+    -mmutable-globals -nostdlib -fno-builtin -fno-exceptions -fno-rtti -Wall -Wextra -Werror \
+    -I"$here/src" -Wl,--no-entry -Wl,--export=__heap_base -Wl,--export=__stack_pointer \
+    -Wl,--shared-memory -Wl,--import-memory -Wl,--max-memory=4294967296 \
     -o "$out/kernel.wasm.tmp" "$web/wasm/kernel.cpp" "$here/src/remora/multires/frame_replay.cpp"
   mv "$out/kernel.wasm.tmp" "$out/kernel.wasm"
 else

@@ -92,14 +92,16 @@ function attachWasm(k, layout) {
     sections.push([offset, array]);
     return offset;
   };
-  const arrays = [k.rest, k.freeLocal, k.basis, k.handleBegin, k.handleLocal, k.faces, k.normalVertices, k.ringBegin,
-    k.ring, k.recordFace, k.recordSlot, k.recordBary, k.recordOffset, k.recordResidual, k.residuals, k.offsets];
-  const pointers = arrays.map(place);
+  const names = ['rest', 'freeLocal', 'basis', 'handleBegin', 'handleLocal', 'faces', 'normalVertices', 'ringBegin',
+    'ring', 'recordFace', 'recordSlot', 'recordBary', 'recordOffset', 'recordResidual', 'residuals', 'offsets'];
+  const pointers = names.map((name) => place(k[name]));
   const x = layout.reserve(8 * 6 * k.local), cross = layout.reserve(8 * 3 * k.ringFaces);
   const transforms = layout.reserve(8 * 12 * k.handles), out = layout.reserve(4 * 3 * k.slots);
   const struct = layout.reserve(4 * 24), control = layout.reserve(16), stack = layout.reserve(WORKER_STACK);
   const instance = layout.instantiate(), memory = instance.buffer;
+  // The JavaScript steps read the same copies: the region's data is held once.
   for (const [offset, array] of sections) new array.constructor(memory, offset, array.length).set(array);
+  names.forEach((name, i) => { if (k[name]) k[name] = new k[name].constructor(memory, pointers[i], k[name].length); });
   new Uint32Array(memory, struct, 24).set([k.handles, k.rows, k.columns, k.normalVertices.length, k.records,
     k.ringFaces, ...pointers, x, cross]);
   k.xn = new Float64Array(memory, x, 6 * k.local);

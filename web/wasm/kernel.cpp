@@ -9,22 +9,6 @@ static_assert(sizeof(remora::FrameReplay) == 24 * 4,
 
 extern "C" {
 
-/// A linear frame: blend, the handles' vertices, normals, decode.
-__attribute__((export_name("frame_linear"))) void
-frame_linear(const remora::FrameReplay* f, const double* transforms, float* out) {
-  remora::replay_blend(*f, transforms);
-  remora::replay_move_handles(*f, transforms);
-  remora::replay_normals(*f);
-  remora::replay_decode(*f, out);
-}
-
-/// Steps 2 and 3 after a step 1 evaluated by the caller into f->x (blended motions).
-__attribute__((export_name("frame_after_blend"))) void
-frame_after_blend(const remora::FrameReplay* f, float* out) {
-  remora::replay_normals(*f);
-  remora::replay_decode(*f, out);
-}
-
 /// Part `part` of `parts` of one step of a linear frame, for a frame split over threads
 /// (web/kernel.js): step 0 the blend (part 0 also moves the handles' vertices), 1 the faces'
 /// cross products, 2 the vertex normals, 3 the decode (a blended-motions frame, whose step 0 is
