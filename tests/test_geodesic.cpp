@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <numeric>
 
 #include <gtest/gtest.h>
 
@@ -142,8 +143,8 @@ std::vector<SurfacePoint> path_along_x(const Mesh& mesh, VertexHandle start, int
 /// A stroke along `path` reports what the union of the full balls holds, each vertex once, at no
 /// less than its distance in the full ball of that source.
 void expect_stroke_is_the_union_of_balls(const Mesh& mesh, const std::vector<SurfacePoint>& path,
-                                         double radius) {
-  FastMarching stroke(mesh), full(mesh);
+                                         double radius, const FastMarchingOptions& options = {}) {
+  FastMarching stroke(mesh, options), full(mesh, options);
   std::vector<int> reported, covered;
   std::vector<char> in_union(mesh.n_vertices(), 0);
   for (const SurfacePoint& at : path) {
@@ -191,6 +192,104 @@ TEST(Geodesic, AStrokeStartsAgainWithAnotherRadiusOrOnRequest) {
   EXPECT_THROW(marching.stroke_ball(grid, at, -1.0), InvalidArgument);
   EXPECT_THROW(marching.stroke_ball(grid, SurfacePoint{FaceHandle(-1), {1, 0, 0}}, 0.2),
                InvalidArgument);
+}
+
+// ---- coarse levels for large balls -------------------------------------------------------------
+
+/// The largest |d - exact| over the ball, and whether every vertex with exact <= inner is in it.
+template <class Exact>
+std::pair<double, bool> error_and_cover(const Mesh& mesh,
+                                        const std::vector<std::pair<int, double>>& ball,
+                                        double inner, Exact exact) {
+  double worst = 0.0;
+  std::vector<char> in(mesh.n_vertices(), 0);
+  for (const auto& [v, d] : ball) {
+    worst = std::max(worst, std::abs(d - exact(v)));
+    in[static_cast<std::size_t>(v)] = 1;
+  }
+  bool covers = true;
+  for (const VertexHandle v : mesh.vertices())
+    if (exact(v.idx()) <= inner && !in[static_cast<std::size_t>(v.idx())]) covers = false;
+  return {worst, covers};
+}
+
+TEST(Geodesic, ACoarseLevelKeepsALargeBallWithinTwoPercentOfItsRadius) {
+  // A plane: the geodesic distance is the straight one.
+  const Mesh grid = make_grid(240, 240, 1.0, 1.0);
+  FastMarching coarse(grid, {.coarse_ratio = 16});
+  const SurfacePoint at{FaceHandle(2 * (120 * 240 + 117)), {0.2, 0.5, 0.3}};
+  const Vec3 c = evaluate(grid, at);
+  for (const double r : {0.12, 0.3, 0.45}) {
+    const auto ball = coarse.ball(grid, at, r);
+    EXPECT_GE(coarse.last_level(), 1) << "radius " << r;
+    EXPECT_GT(coarse.last_cell(), r / 16 * 0.99);
+    EXPECT_LE(coarse.last_cell(), r / 8 * 1.01);
+    const auto [error, covers] = error_and_cover(
+        grid, ball, 0.98 * r, [&](int v) { return (grid.point(VertexHandle(v)) - c).norm(); });
+    EXPECT_LT(error, 0.02 * r) << "radius " << r;
+    EXPECT_TRUE(covers) << "radius " << r;
+    for (std::size_t i = 1; i < ball.size(); ++i) ASSERT_LE(ball[i - 1].second, ball[i].second);
+    // No coarse level below coarse_ratio mean edges: the fine ball, bit for bit.
+    EXPECT_EQ(FastMarching(grid, {.coarse_ratio = 1e6}).ball(grid, at, r),
+              geodesic_ball(grid, at, r));
+  }
+  // A sphere: the great-circle distance (cells of a tenth of its radius at most: a coarser level
+  // cuts through its curvature).
+  const Mesh sphere = make_icosphere(6, 1.0);
+  FastMarching marching(sphere, {.coarse_ratio = 32});
+  const Vec3 p = sphere.point(VertexHandle(3));
+  for (const double r : {0.8, 1.5, 2.5}) {
+    const auto ball = marching.ball(sphere, VertexHandle(3), r);
+    EXPECT_GE(marching.last_level(), 1);
+    const auto [error, covers] = error_and_cover(sphere, ball, 0.98 * r, [&](int v) {
+      return std::acos(std::clamp(OpenMesh::dot(sphere.point(VertexHandle(v)), p), -1.0, 1.0));
+    });
+    EXPECT_LT(error, 0.02 * r) << "radius " << r;
+    EXPECT_TRUE(covers) << "radius " << r;
+  }
+  // A radius beyond the whole sphere: all of it.
+  EXPECT_EQ(marching.ball(sphere, VertexHandle(3), 100.0).size(), sphere.n_vertices());
+  EXPECT_THROW(FastMarching(sphere, {.coarse_ratio = -1}), InvalidArgument);
+}
+
+TEST(Geodesic, ACoarseStrokeReportsTheUnionOfItsBallsEachVertexOnce) {
+  const FastMarchingOptions levels{.coarse_ratio = 8};
+  const Mesh grid = make_grid(160, 160, 1.0, 1.0);
+  expect_stroke_is_the_union_of_balls(grid, path_along_x(grid, VertexHandle(80 * 161 + 30), 40),
+                                      0.2, levels);
+  const Mesh sphere = make_icosphere(5, 1.0);
+  expect_stroke_is_the_union_of_balls(sphere, path_along_x(sphere, VertexHandle(7), 25), 0.7,
+                                      levels);
+  const Mesh bunny = read_mesh(std::string(REMORA_REPO_DATA) + "/bunny.ply").mesh;
+  for (const double r : {0.03, 0.06})
+    expect_stroke_is_the_union_of_balls(bunny, path_along_x(bunny, VertexHandle(1000), 30), r,
+                                        levels);
+}
+
+TEST(Geodesic, ACoarseLevelFollowsMovedVerticesAtAStrokesStart) {
+  Mesh grid = make_grid(120, 120, 1.0, 1.0);
+  FastMarching marching(grid, {.coarse_ratio = 8});
+  const SurfacePoint at{FaceHandle(2 * (60 * 120 + 60)), {0.3, 0.3, 0.4}};
+  const double r = 0.3;
+  const auto flat = marching.ball(grid, at, r);
+  ASSERT_GE(marching.last_level(), 1);
+  // Stretched by 1.5 along y: the ball follows the new distances, not the clusters' old points.
+  for (const VertexHandle v : grid.vertices()) {
+    const Vec3 q = grid.point(v);
+    grid.set_point(v, Vec3(q[0], 1.5 * q[1], q[2]));
+  }
+  const Vec3 c = evaluate(grid, at);
+  const auto straight = [&](int v) { return (grid.point(VertexHandle(v)) - c).norm(); };
+  // Not told: the clusters keep their old points, and the ball misses much of the new one.
+  EXPECT_FALSE(error_and_cover(grid, marching.ball(grid, at, r), 0.98 * r, straight).second);
+  std::vector<int> all(grid.n_vertices());
+  std::iota(all.begin(), all.end(), 0);
+  marching.positions_changed(grid, all);
+  const auto stretched = marching.ball(grid, at, r);
+  const auto [error, covers] = error_and_cover(grid, stretched, 0.98 * r, straight);
+  EXPECT_LT(error, 0.02 * r);
+  EXPECT_TRUE(covers);
+  EXPECT_LT(static_cast<double>(stretched.size()), 0.75 * static_cast<double>(flat.size()));
 }
 
 TEST(Geodesic, RefusesBadArguments) {

@@ -18,8 +18,10 @@
 #include "remora/geometry/geodesic.h"
 #include "remora/geometry/raycast.h"
 #include "remora/mesh/io.h"
+#include "remora/mesh/primitives.h"
 #include "server_support.h"
 #include "session.h"
+#include "shape.h"
 
 // Last: it includes httplib.h, whose <resolv.h> `_res` macro breaks Eigen's headers if they follow.
 #include "loopback.h" // NOLINT(llvm-include-order)
@@ -29,6 +31,12 @@ namespace {
 
 using nlohmann::json;
 using namespace testing_server;
+
+/// The library's geodesic brush as the server marches it.
+std::vector<std::pair<int, double>> brush_ball(const Mesh& mesh, const SurfacePoint& at,
+                                               double radius) {
+  return FastMarching(mesh, {.coarse_ratio = kBrushCoarseRatio}).ball(mesh, at, radius);
+}
 
 TEST(ServerEditing, ANewKKeepsTheMoveWithoutABakeAndUndoComesBack) {
   Session s;
@@ -302,7 +310,7 @@ TEST(ServerEditing, PicksAndBrushesAreTheLibrarysOnTheShapeShown) {
     ASSERT_TRUE(hit.face.is_valid());
     EXPECT_EQ(got.headers.at("X-Hit-Face"), std::to_string(hit.face.idx()));
     std::vector<std::uint32_t> expected;
-    for (const auto& [v, d] : geodesic_ball(mesh, SurfacePoint{hit.face, hit.bary}, radius))
+    for (const auto& [v, d] : brush_ball(mesh, SurfacePoint{hit.face, hit.bary}, radius))
       expected.push_back(static_cast<std::uint32_t>(v));
     std::sort(expected.begin(), expected.end());
     EXPECT_EQ(brush_of(got), expected) << "radius " << radius;
@@ -331,7 +339,7 @@ TEST(ServerEditing, PicksAndBrushesAreTheLibrarysOnTheShapeShown) {
   EXPECT_EQ(lifted.headers.at("X-Hit-Face"), std::to_string(hit.face.idx()));
   EXPECT_GT(evaluate(mesh, SurfacePoint{hit.face, hit.bary})[2], 1.3);
   std::vector<std::uint32_t> expected;
-  for (const auto& [v, d] : geodesic_ball(mesh, SurfacePoint{hit.face, hit.bary}, 0.2))
+  for (const auto& [v, d] : brush_ball(mesh, SurfacePoint{hit.face, hit.bary}, 0.2))
     expected.push_back(static_cast<std::uint32_t>(v));
   std::sort(expected.begin(), expected.end());
   EXPECT_EQ(brush_of(lifted), expected);
@@ -342,6 +350,50 @@ TEST(ServerEditing, PicksAndBrushesAreTheLibrarysOnTheShapeShown) {
   for (const VertexHandle v : mesh.vertices())
     if ((mesh.point(v) - at).norm() <= 0.2) within.push_back(static_cast<std::uint32_t>(v.idx()));
   EXPECT_EQ(brush_of(sphere), within);
+}
+
+TEST(ServerEditing, ACoarseBrushFollowsTheShapeThroughADragAndAWholeChange) {
+  // Coarse levels from 2 mean edge lengths, so that a unit sphere's brushes use them.
+  Mesh mesh = make_icosphere(4, 1.0);
+  Shape shape(mesh, 2.0);
+  FastMarching library(mesh, {.coarse_ratio = 2.0}); // clustered at the same rest positions
+  const Vec3 above(0.05, 0.1, 3), down(0, 0, -1);
+  const auto expect_library_brush = [&](const char* when) {
+    const Pick got = shape.pick(above, down, 0.9, Brush::Geodesic);
+    const RayHit hit = RayCaster(mesh).first_hit(above, down, 0.0, 1e300);
+    ASSERT_EQ(got.face, hit.face.idx()) << when;
+    std::vector<std::uint32_t> expected;
+    for (const auto& [v, d] : library.ball(mesh, SurfacePoint{hit.face, hit.bary}, 0.9))
+      expected.push_back(static_cast<std::uint32_t>(v));
+    std::sort(expected.begin(), expected.end());
+    EXPECT_GE(library.last_level(), 1) << when;
+    EXPECT_EQ(got.brush, expected) << when;
+  };
+  expect_library_brush("at rest");
+  // A drag moves the cap: the shape reads again only the clusters around it, the library all.
+  std::vector<int> cap;
+  Eigen::MatrixXd positions(mesh.n_vertices(), 3);
+  for (const VertexHandle v : mesh.vertices()) {
+    Vec3 p = mesh.point(v);
+    if (p[2] > 0.3) {
+      cap.push_back(v.idx());
+      p = Vec3(p[0] * 1.3, p[1] * 0.8, p[2] + 0.4 * (p[2] - 0.3));
+      mesh.set_point(v, p);
+    }
+    positions.row(v.idx()) << p[0], p[1], p[2];
+  }
+  shape.set_positions(cap, positions);
+  library.positions_changed();
+  expect_library_brush("after a drag");
+  // Every vertex moved (an undo, a bake).
+  for (const VertexHandle v : mesh.vertices()) {
+    const Vec3 p = mesh.point(v) * 1.1;
+    mesh.set_point(v, p);
+    positions.row(v.idx()) << p[0], p[1], p[2];
+  }
+  shape.set_positions(positions);
+  library.positions_changed();
+  expect_library_brush("after a whole change");
 }
 
 TEST(ServerEditing, APicksStrokeAnswersOnlyWhatItsEarlierPicksDidNot) {

@@ -18,9 +18,16 @@ Brush parse_brush(const std::string& name) {
   throw InvalidArgument(fmt::format("unknown brush '{}': use geodesic or sphere", name));
 }
 
-// The caster is built here, on the load's worker, not on the first pick (half a second on a
-// million triangles).
-Shape::Shape(const Mesh& mesh) : mesh_(mesh), caster_(mesh_), marching_(mesh_) {}
+// The caster and the brush's coarse levels are built here, on the load's worker, not on the
+// first pick (half a second and a few tenths on a million triangles). The levels are those of
+// every brush up to the page's largest, the radius of the bounding sphere.
+Shape::Shape(const Mesh& mesh, double coarse_ratio)
+    : mesh_(mesh), caster_(mesh_), marching_(mesh_, {.coarse_ratio = coarse_ratio}) {
+  Vec3 low(std::numeric_limits<double>::infinity()), high(-low);
+  for (const VertexHandle v : mesh_.vertices())
+    low.minimize(mesh_.point(v)), high.maximize(mesh_.point(v));
+  if (mesh_.n_vertices() > 0) marching_.prepare(mesh_, 0.5 * (high - low).norm());
+}
 
 void Shape::set_positions(const Eigen::MatrixXd& positions) {
   for (const VertexHandle v : mesh_.vertices())
@@ -56,10 +63,13 @@ Pick Shape::pick(const Vec3& origin, const Vec3& direction, double radius, Brush
   if (stroke < 0 || stroke != stroke_ || brush != stroke_brush_ || radius != stroke_radius_ ||
       stale_ || !moved_.empty())
     start_stroke(stroke, brush, radius);
-  if (stale_)
+  if (stale_) {
     caster_.refit(mesh_);
-  else if (!moved_.empty())
+    marching_.positions_changed();
+  } else if (!moved_.empty()) {
     caster_.refit(mesh_, moved_); // a drag moved only its region
+    marching_.positions_changed(mesh_, moved_);
+  }
   stale_ = false;
   for (const int i : moved_) moved_flag_[static_cast<std::size_t>(i)] = 0;
   moved_.clear();

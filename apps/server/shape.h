@@ -21,6 +21,10 @@ enum class Brush {
 };
 Brush parse_brush(const std::string& name); ///< "geodesic" or "sphere"; InvalidArgument else
 
+/// A geodesic brush wider than this many mean edge lengths marches on a coarser level
+/// (FastMarchingOptions::coarse_ratio): a pointer move then costs about the same at any radius.
+constexpr double kBrushCoarseRatio = 64.0;
+
 struct Pick {
   int face = -1;                    ///< the face met first, -1 when the ray met nothing
   Vec3 point{0, 0, 0};              ///< where
@@ -30,9 +34,10 @@ struct Pick {
 
 class Shape {
 public:
-  /// Copies the mesh (its faces and current positions) and builds the ray caster over it.
+  /// Copies the mesh (its faces and current positions) and builds the ray caster over it, and
+  /// the geodesic brush's coarse levels (FastMarchingOptions::coarse_ratio; 0: none).
   /// Throws InvalidArgument for a corner that is not finite.
-  explicit Shape(const Mesh& mesh);
+  explicit Shape(const Mesh& mesh, double coarse_ratio = kBrushCoarseRatio);
 
   /// Every vertex moves to the rows of `positions` (n_vertices × 3).
   void set_positions(const Eigen::MatrixXd& positions);

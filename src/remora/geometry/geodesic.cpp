@@ -2,9 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
-#include <functional>
 #include <limits>
-#include <queue>
 
 #include <fmt/format.h>
 
@@ -14,31 +12,7 @@ namespace remora {
 
 namespace {
 
-constexpr double kInf = std::numeric_limits<double>::infinity();
-constexpr std::uint8_t kFar = 0, kTrial = 1, kAccepted = 2;
-
-/// The distance at c of triangle (a, b, c), given by its edge lengths ab, ac, bc, from the
-/// distances da at a and db at b: the triangle unfolded into the plane, a virtual source on the
-/// far side of ab at distances da and db, and the straight line from it to c if that line crosses
-/// ab; otherwise the shorter edge path.
-double through_triangle(double ab, double ac, double bc, double da, double db) {
-  const double edge_path = std::min(da + ac, db + bc);
-  if (!(ab > 0.0)) return edge_path;
-  // a at the origin, b on the positive x axis, c above it.
-  const double cx = (ac * ac - bc * bc + ab * ab) / (2.0 * ab);
-  const double cy2 = ac * ac - cx * cx;
-  if (!(cy2 > 0.0)) return edge_path;
-  const double cy = std::sqrt(cy2);
-  const double sx = (da * da - db * db + ab * ab) / (2.0 * ab);
-  const double sy2 = da * da - sx * sx;
-  if (sy2 < 0.0) return edge_path; // da, db and ab violate the triangle inequality
-  const double sy = -std::sqrt(sy2);
-  const double t = -sy / (cy - sy); // where the line from s to c meets the x axis
-  const double x = sx + t * (cx - sx);
-  if (x < 0.0 || x > ab) return edge_path;
-  const double dx = cx - sx, dy = cy - sy; // magnitudes of the mesh's size: no overflow
-  return std::min(edge_path, std::sqrt(dx * dx + dy * dy));
-}
+constexpr int kMaxLevel = 40; // cells of 2^40 mean edge lengths: one cluster per component
 
 void check_radius(double radius) {
   if (!(radius >= 0.0) || !std::isfinite(radius))
@@ -46,95 +20,115 @@ void check_radius(double radius) {
         fmt::format("geodesic ball: the radius {} must be finite and >= 0", radius));
 }
 
-} // namespace
+std::vector<std::array<int, 3>> face_corners(const Mesh& mesh) {
+  std::vector<std::array<int, 3>> triangles;
+  triangles.reserve(mesh.n_faces());
+  for (const FaceHandle f : mesh.faces()) {
+    const auto c = face_vertices(mesh, f);
+    triangles.push_back({c[0].idx(), c[1].idx(), c[2].idx()});
+  }
+  return triangles;
+}
 
-FastMarching::FastMarching(const Mesh& mesh)
-    : faces_(mesh.n_faces()), ring_begin_(mesh.n_vertices() + 1, 0),
-      distance_(mesh.n_vertices(), kInf), state_(mesh.n_vertices(), kFar),
-      nearest_(mesh.n_vertices(), kInf) {
-  for (const FaceHandle f : mesh.faces())
-    for (const VertexHandle v : face_vertices(mesh, f)) ++ring_begin_[v.idx() + 1];
-  for (std::size_t v = 0; v < mesh.n_vertices(); ++v) ring_begin_[v + 1] += ring_begin_[v];
-  ring_.resize(ring_begin_.back());
-  std::vector<std::uint32_t> fill(ring_begin_.begin(), ring_begin_.end() - 1);
+double mean_edge_length(const Mesh& mesh) {
+  double sum = 0.0;
+  std::size_t count = 0;
   for (const FaceHandle f : mesh.faces()) {
     const auto c = face_vertices(mesh, f);
     for (std::size_t k = 0; k < 3; ++k)
-      ring_[fill[static_cast<std::size_t>(c[k].idx())]++] = {c[(k + 1) % 3].idx(),
-                                                             c[(k + 2) % 3].idx()};
+      sum += (mesh.point(c[k]) - mesh.point(c[(k + 1) % 3])).norm();
+    count += 3;
   }
+  return count > 0 ? sum / static_cast<double>(count) : 0.0;
+}
+
+} // namespace
+
+FastMarching::FastMarching(const Mesh& mesh, const FastMarchingOptions& options)
+    : faces_(mesh.n_faces()), options_(options) {
+  if (!(options.coarse_ratio >= 0.0) || !std::isfinite(options.coarse_ratio))
+    throw InvalidArgument(
+        fmt::format("geodesic ball: coarse_ratio {} must be finite and >= 0 (0: no coarse levels)",
+                    options.coarse_ratio));
+  auto corners = face_corners(mesh);
+  marcher_ = Marcher(march_rings(mesh.n_vertices(), corners));
+  if (options.coarse_ratio > 0.0) {
+    mean_edge_ = mean_edge_length(mesh);
+    corners_ = std::make_shared<const std::vector<std::array<int, 3>>>(std::move(corners));
+  }
+}
+
+FastMarching::~FastMarching() = default;
+FastMarching::FastMarching(FastMarching&&) noexcept = default;
+FastMarching& FastMarching::operator=(FastMarching&&) noexcept = default;
+
+double FastMarching::last_cell() const {
+  return last_level_ > 0 ? levels_[static_cast<std::size_t>(last_level_ - 1)]->cell() : 0.0;
+}
+
+void FastMarching::check_mesh(const Mesh& mesh) const {
+  if (mesh.n_vertices() != marcher_.size() || mesh.n_faces() != faces_)
+    throw InvalidArgument(fmt::format(
+        "geodesic ball: the mesh has {} vertices and {} faces; the marcher was built for {} and {}",
+        mesh.n_vertices(), mesh.n_faces(), marcher_.size(), faces_));
+}
+
+int FastMarching::level_for(double radius) const {
+  const double reach = options_.coarse_ratio * mean_edge_; // the largest radius of level 0
+  if (!(reach > 0.0) || radius <= reach) return 0;
+  const int k = static_cast<int>(std::ceil(std::log2(radius / reach)));
+  return std::clamp(k, 1, kMaxLevel);
 }
 
 std::vector<std::pair<int, double>>
-FastMarching::march(const Mesh& mesh, const std::vector<std::pair<int, double>>& seeds,
-                    double radius) {
-  if (mesh.n_vertices() != distance_.size() || mesh.n_faces() != faces_)
-    throw InvalidArgument(fmt::format(
-        "geodesic ball: the mesh has {} vertices and {} faces; the marcher was built for {} and {}",
-        mesh.n_vertices(), mesh.n_faces(), distance_.size(), faces_));
-  for (const int v : touched_) {
-    distance_[static_cast<std::size_t>(v)] = kInf;
-    state_[static_cast<std::size_t>(v)] = kFar;
-  }
-  touched_.clear();
-  const bool first = stroke_touched_.empty(); // the whole ball: measure the slack on it
-  double edge_sum = 0.0;
-  std::size_t edges = 0;
-  const Vec3* points = mesh.points();
-  using Item = std::pair<double, int>;
-  std::priority_queue<Item, std::vector<Item>, std::greater<>> front;
-  auto offer = [&](int v, double d) {
-    const auto i = static_cast<std::size_t>(v);
-    // Beyond the radius it is never accepted; where an earlier source of the stroke is nearer
-    // by more than the slack, no vertex beyond it is new.
-    if (!(d < distance_[i]) || d > radius || !(d < nearest_[i] + slack_)) return;
-    if (state_[i] == kFar) {
-      state_[i] = kTrial;
-      touched_.push_back(v);
-    }
-    distance_[i] = d;
-    front.push({d, v});
-  };
-  for (const auto& [v, d] : seeds) offer(v, d);
+FastMarching::fine(const Mesh& mesh, const std::vector<std::pair<int, double>>& seeds,
+                   double radius) {
+  last_level_ = 0;
   std::vector<std::pair<int, double>> out;
-  while (!front.empty()) {
-    const auto [d, v] = front.top();
-    front.pop();
-    const auto i = static_cast<std::size_t>(v);
-    if (state_[i] == kAccepted || d > distance_[i]) continue; // a stale entry
-    state_[i] = kAccepted;
-    if (nearest_[i] == kInf) {
-      out.emplace_back(v, d);
-      stroke_touched_.push_back(v);
-    }
-    nearest_[i] = std::min(nearest_[i], d);
-    const Vec3& pv = points[i];
-    for (std::uint32_t r = ring_begin_[i]; r < ring_begin_[i + 1]; ++r) {
-      const auto p = static_cast<std::size_t>(ring_[r][0]);
-      const auto q = static_cast<std::size_t>(ring_[r][1]);
-      const bool p_done = state_[p] == kAccepted, q_done = state_[q] == kAccepted;
-      if (p_done && q_done) continue;
-      const double vp = (points[p] - pv).norm(), vq = (points[q] - pv).norm();
-      if (first) edge_sum += vp, ++edges;
-      // Each corner not yet accepted: along the edge, or through the triangle from the other.
-      if (!p_done)
-        offer(static_cast<int>(p),
-              q_done ? std::min(d + vp, through_triangle(vq, vp, (points[p] - points[q]).norm(), d,
-                                                         distance_[q]))
-                     : d + vp);
-      if (!q_done)
-        offer(static_cast<int>(q),
-              p_done ? std::min(d + vq, through_triangle(vp, vq, (points[q] - points[p]).norm(), d,
-                                                         distance_[p]))
-                     : d + vq);
-    }
-  }
-  if (first && edges > 0) slack_ = 2.0 * edge_sum / static_cast<double>(edges);
+  for (const Accepted& a : marcher_.march(mesh.points(), seeds, radius, 0.0))
+    if (a.fresh) out.emplace_back(a.vertex, a.distance);
   return out;
 }
 
-std::vector<std::pair<int, double>> FastMarching::seeds_of(const Mesh& mesh,
-                                                           const SurfacePoint& source) {
+void FastMarching::start_stroke() {
+  marcher_.start_stroke();
+  for (const auto& level : levels_)
+    if (level) level->start_stroke();
+  stroke_radius_ = -1.0;
+}
+
+CoarseLevel& FastMarching::level(const Mesh& mesh, int k) {
+  if (levels_.size() < static_cast<std::size_t>(k)) levels_.resize(static_cast<std::size_t>(k));
+  auto& level = levels_[static_cast<std::size_t>(k - 1)];
+  if (!level)
+    level = std::make_unique<CoarseLevel>(mesh, corners_, mean_edge_ * std::ldexp(1.0, k));
+  return *level;
+}
+
+void FastMarching::prepare(const Mesh& mesh, double radius) {
+  check_radius(radius);
+  check_mesh(mesh);
+  for (int k = 1; k <= level_for(radius); ++k) level(mesh, k);
+}
+
+void FastMarching::positions_changed(const Mesh& mesh, const std::vector<int>& vertices) {
+  check_mesh(mesh);
+  for (const int v : vertices)
+    if (v < 0 || static_cast<std::size_t>(v) >= mesh.n_vertices())
+      throw InvalidArgument(fmt::format("geodesic ball: vertex {} is not a vertex of the mesh", v));
+  for (const auto& level : levels_)
+    if (level) level->positions_changed(mesh, vertices);
+}
+
+void FastMarching::positions_changed() {
+  for (const auto& level : levels_)
+    if (level) level->positions_changed();
+}
+
+std::vector<std::pair<int, double>>
+FastMarching::stroke_ball(const Mesh& mesh, const SurfacePoint& source, double radius) {
+  check_radius(radius);
+  check_mesh(mesh);
   const FaceHandle f = source.face;
   if (!f.is_valid() || f.idx() >= static_cast<int>(mesh.n_faces()) || mesh.status(f).deleted())
     throw InvalidArgument(
@@ -143,47 +137,51 @@ std::vector<std::pair<int, double>> FastMarching::seeds_of(const Mesh& mesh,
   for (const double b : source.bary)
     if (!std::isfinite(b))
       throw InvalidArgument("geodesic ball: the source's barycentric coordinates are not finite");
-  const Vec3 point = evaluate(mesh, source);
-  std::vector<std::pair<int, double>> seeds;
-  for (const VertexHandle v : face_vertices(mesh, f))
-    seeds.emplace_back(v.idx(), (mesh.point(v) - point).norm());
-  return seeds;
-}
-
-void FastMarching::start_stroke() {
-  for (const int v : stroke_touched_) nearest_[static_cast<std::size_t>(v)] = kInf;
-  stroke_touched_.clear();
-  stroke_radius_ = -1.0;
-  slack_ = 0.0;
-}
-
-std::vector<std::pair<int, double>>
-FastMarching::stroke_ball(const Mesh& mesh, const SurfacePoint& source, double radius) {
-  check_radius(radius);
-  const auto seeds = seeds_of(mesh, source);
   if (radius != stroke_radius_) start_stroke();
   stroke_radius_ = radius;
-  return march(mesh, seeds, radius);
+  const Vec3 point = evaluate(mesh, source);
+  const auto corners = face_vertices(mesh, f);
+  const int k = level_for(radius);
+  if (k == 0) {
+    std::vector<std::pair<int, double>> seeds;
+    for (const VertexHandle v : corners)
+      seeds.emplace_back(v.idx(), (mesh.point(v) - point).norm());
+    return fine(mesh, seeds, radius);
+  }
+  auto& coarse = level(mesh, k);
+  last_level_ = k;
+  return coarse.stroke_ball(mesh, point, {corners[0].idx(), corners[1].idx(), corners[2].idx()},
+                            radius);
 }
 
 std::vector<std::pair<int, double>> FastMarching::ball(const Mesh& mesh, const SurfacePoint& source,
                                                        double radius) {
-  check_radius(radius);
-  const auto seeds = seeds_of(mesh, source);
   start_stroke();
-  return march(mesh, seeds, radius);
+  auto out = stroke_ball(mesh, source, radius);
+  stroke_radius_ = -1.0; // the next stroke_ball() starts a stroke
+  return out;
 }
 
 std::vector<std::pair<int, double>> FastMarching::ball(const Mesh& mesh, VertexHandle source,
                                                        double radius) {
   check_radius(radius);
+  check_mesh(mesh);
   if (!source.is_valid() || source.idx() >= static_cast<int>(mesh.n_vertices()) ||
       mesh.status(source).deleted())
     throw InvalidArgument(
         fmt::format("geodesic ball: vertex {} is not a vertex of the mesh (it has {} vertices)",
                     source.idx(), mesh.n_vertices()));
+  if (level_for(radius) > 0) // the same ball from a face at the vertex
+    for (const FaceHandle f : mesh.vf_range(source)) {
+      const auto corners = face_vertices(mesh, f);
+      std::array<double, 3> bary{};
+      for (std::size_t k = 0; k < 3; ++k) bary[k] = corners[k] == source ? 1.0 : 0.0;
+      return ball(mesh, SurfacePoint{f, bary}, radius);
+    }
   start_stroke();
-  return march(mesh, {{source.idx(), 0.0}}, radius);
+  auto out = fine(mesh, {{source.idx(), 0.0}}, radius);
+  stroke_radius_ = -1.0;
+  return out;
 }
 
 std::vector<std::pair<int, double>> geodesic_ball(const Mesh& mesh, const SurfacePoint& source,

@@ -10,6 +10,10 @@
 // the triangle, so the result is never below the straight-line distance of a flat region and never
 // above the edge-path distance. Only the source's connected component is reached.
 //
+// A large ball may be marched on a coarser level (FastMarchingOptions::coarse_ratio, off by
+// default; geometry/geodesic_levels.h): its cost is then bounded whatever its radius, and its
+// distances lose a little accuracy (within 2 % of the radius on a plane and a sphere; the tests).
+//
 // A brush stroke paints the union of balls of one radius along the pointer's path. Marching each
 // ball in full costs the ball's area per pointer move; a stroke (FastMarching::stroke_ball) marches
 // from the new source only where it comes nearer than every earlier source of the stroke (plus a
@@ -21,21 +25,36 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 #include <utility>
 #include <vector>
 
+#include "remora/geometry/geodesic_levels.h"
+#include "remora/geometry/geodesic_march.h"
 #include "remora/mesh/mesh.h"
 #include "remora/mesh/surface_point.h"
 
 namespace remora {
 
+struct FastMarchingOptions {
+  /// 0: every ball is marched on the mesh itself. Otherwise a ball whose radius exceeds
+  /// `coarse_ratio` mean edge lengths is marched on the coarser level whose cells are between
+  /// radius / coarse_ratio and twice that (edges of 2^k mean edge lengths, k >= 1), built the
+  /// first time a ball needs it. The browser editor's brush uses 64.
+  double coarse_ratio = 0.0;
+};
+
 /// Fast marching on one mesh's faces, for many balls (the page's brush marches on every pointer
 /// move): keeps, for every vertex, the far edges of its faces, and the scratch memory. The
-/// positions are read from the mesh at each call, so its vertices may move between calls; its
-/// faces may not. Not thread-safe: one per thread.
+/// positions are read from the mesh at each call, so its vertices may move between strokes; its
+/// faces may not. A coarse level keeps its clusters' points: tell it, with positions_changed(),
+/// which vertices moved. Not thread-safe: one per thread.
 class FastMarching {
 public:
-  explicit FastMarching(const Mesh& mesh);
+  explicit FastMarching(const Mesh& mesh, const FastMarchingOptions& options = {});
+  ~FastMarching();
+  FastMarching(FastMarching&&) noexcept;
+  FastMarching& operator=(FastMarching&&) noexcept;
 
   /// The vertices within geodesic distance `radius` of `source` (a point on a face: its three
   /// corners start at their straight-line distance from it), with their distances, in increasing
@@ -57,26 +76,37 @@ public:
   /// Forgets the stroke: the next stroke_ball() reports its whole ball.
   void start_stroke();
 
+  /// Builds now the coarse levels that balls of radius up to `radius` need (otherwise each is
+  /// built by the first ball that needs it: 0.1–0.3 s on a million triangles).
+  void prepare(const Mesh& mesh, double radius);
+
+  /// `vertices` of `mesh` (or all of them) moved: the coarse levels read their clusters again
+  /// at the next stroke's start. Not needed for balls on the mesh itself.
+  void positions_changed(const Mesh& mesh, const std::vector<int>& vertices);
+  void positions_changed();
+
+  /// The level the last ball was marched on: 0 the mesh itself, k >= 1 cells of 2^k mean edge
+  /// lengths; and that level's cell size (0 for the mesh).
+  int last_level() const { return last_level_; }
+  double last_cell() const;
+
 private:
+  void check_mesh(const Mesh& mesh) const;
+  int level_for(double radius) const;
+  CoarseLevel& level(const Mesh& mesh, int k);
   std::vector<std::pair<int, double>>
-  march(const Mesh& mesh, const std::vector<std::pair<int, double>>& seeds, double radius);
-  std::vector<std::pair<int, double>> seeds_of(const Mesh& mesh, const SurfacePoint& source);
+  fine(const Mesh& mesh, const std::vector<std::pair<int, double>>& seeds, double radius);
   std::size_t faces_ = 0;
-  std::vector<std::uint32_t> ring_begin_; ///< vertex v's far edges: ring_[ring_begin_[v] ..
-  std::vector<std::array<int, 2>>
-      ring_;                        ///< .. ring_begin_[v + 1]), each (p, q) with (v, p, q) a face
-  std::vector<double> distance_;    ///< +inf except where the last march wrote
-  std::vector<std::uint8_t> state_; ///< far, trial, accepted
-  std::vector<int> touched_;        ///< what to reset before the next march
-  // The stroke: the distance from its nearest earlier source of every vertex a ball of it
-  // reached (+inf elsewhere), which marks it reported; the radius, the slack, what to reset.
-  std::vector<double> nearest_;
-  std::vector<int> stroke_touched_;
-  double stroke_radius_ = -1.0; ///< < 0: no stroke
-  double slack_ = 0.0;
+  FastMarchingOptions options_;
+  double mean_edge_ = 0.0;
+  Marcher marcher_;
+  std::shared_ptr<const std::vector<std::array<int, 3>>> corners_; ///< the faces', for the levels
+  std::vector<std::unique_ptr<CoarseLevel>> levels_; ///< levels_[k - 1], built when first used
+  double stroke_radius_ = -1.0;                      ///< < 0: no stroke
+  int last_level_ = 0;
 };
 
-/// FastMarching(mesh).ball(mesh, source, radius): one ball.
+/// FastMarching(mesh).ball(mesh, source, radius): one ball, on the mesh itself.
 std::vector<std::pair<int, double>> geodesic_ball(const Mesh& mesh, const SurfacePoint& source,
                                                   double radius);
 std::vector<std::pair<int, double>> geodesic_ball(const Mesh& mesh, VertexHandle source,
