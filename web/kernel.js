@@ -57,16 +57,6 @@ export function parseKernel(buffer) {
   let ringFaces = 0;
   for (let i = 0; i < k.ring.length; ++i) ringFaces = Math.max(ringFaces, k.ring[i] + 1);
   k.ringFaces = ringFaces; // the normals' faces come first among the faces
-  // The frame's working rows, a vertex's position and normal side by side (one cache line read per
-  // corner), in double precision, at rest to begin with (rows that no frame writes keep them); the
-  // faces' corners as offsets into them.
-  k.xn = Float64Array.from(k.rest);
-  k.faceRows = new Uint32Array(3 * ringFaces);
-  for (let i = 0; i < k.faceRows.length; ++i) k.faceRows[i] = 6 * k.faces[i];
-  k.recordRows = new Uint32Array(3 * records);
-  for (let r = 0; r < records; ++r)
-    for (let c = 0; c < 3; ++c) k.recordRows[3 * r + c] = 6 * k.faces[3 * k.recordFace[r] + c];
-  k.cross = new Float64Array(3 * ringFaces);
   // Blended motions: the handles' pivots, the centroids of their rest positions.
   k.pivots = [];
   for (let j = 0; j < handles; ++j) {
@@ -77,7 +67,23 @@ export function parseKernel(buffer) {
   }
   const layout = wasmLayout();
   if (layout) attachWasm(k, layout);
+  // The frame's working rows, a vertex's position and normal side by side (one cache line read per
+  // corner), in double precision, at rest to begin with (rows that no frame writes keep them).
+  else k.xn = Float64Array.from(k.rest);
   return k;
+}
+
+/// The arrays only the JavaScript steps read, built the first time they run (a region evaluated
+/// in WebAssembly does without them: 18 MB at a 480k-vertex support): the faces' corners and the
+/// records' as offsets into the working rows, and the faces' cross products.
+function javascriptRows(k) {
+  if (k.faceRows) return;
+  k.faceRows = new Uint32Array(3 * k.ringFaces);
+  for (let i = 0; i < k.faceRows.length; ++i) k.faceRows[i] = 6 * k.faces[i];
+  k.recordRows = new Uint32Array(3 * k.records);
+  for (let r = 0; r < k.records; ++r)
+    for (let c = 0; c < 3; ++c) k.recordRows[3 * r + c] = 6 * k.faces[3 * k.recordFace[r] + c];
+  k.cross = new Float64Array(3 * k.ringFaces);
 }
 
 /// Copies the kernel's arrays into the memory of a new instance of kernel.wasm (web/engine.js; one
@@ -153,6 +159,7 @@ export function evaluateKernel(k, transforms, out, engine = 'wasm') {
     out.set(result.length <= out.length ? result : result.subarray(0, out.length));
     return out;
   }
+  javascriptRows(k);
   if (k.blended) blendMotions(k, transforms);
   else blend(k, transforms);
   normals(k);
