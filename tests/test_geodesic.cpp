@@ -2,6 +2,7 @@
 // plane and a sphere, against edge paths (which give diamonds), and its contract.
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <numeric>
 
@@ -264,6 +265,79 @@ TEST(Geodesic, ACoarseStrokeReportsTheUnionOfItsBallsEachVertexOnce) {
   for (const double r : {0.03, 0.06})
     expect_stroke_is_the_union_of_balls(bunny, path_along_x(bunny, VertexHandle(1000), 30), r,
                                         levels);
+}
+
+TEST(Geodesic, ACoarseStrokeOfLongStepsStillReportsTheUnion) {
+  // Steps of several cells: the earlier sources' margin (twice the clusters' spread) matters.
+  const FastMarchingOptions levels{.coarse_ratio = 8};
+  const Mesh sphere = make_icosphere(5, 1.0);
+  const auto dense = path_along_x(sphere, VertexHandle(7), 60);
+  std::vector<SurfacePoint> sparse;
+  for (std::size_t i = 0; i < dense.size(); i += 6) sparse.push_back(dense[i]);
+  expect_stroke_is_the_union_of_balls(sphere, sparse, 0.6, levels);
+  const Mesh bunny = read_mesh(std::string(REMORA_REPO_DATA) + "/bunny.ply").mesh;
+  const auto along = path_along_x(bunny, VertexHandle(1000), 80);
+  std::vector<SurfacePoint> far;
+  for (std::size_t i = 0; i < along.size(); i += 8) far.push_back(along[i]);
+  expect_stroke_is_the_union_of_balls(bunny, far, 0.05, levels);
+}
+
+TEST(Geodesic, ACoarseLevelToldOfSomeMovedVerticesEqualsOneToldOfAll) {
+  // A bump pushed out of a sphere changes points, spreads and normals around it; the marcher
+  // told only of the bump's vertices must read again every cluster that changed.
+  Mesh sphere = make_icosphere(5, 1.0);
+  FastMarching some(sphere, {.coarse_ratio = 4}), all(sphere, {.coarse_ratio = 4});
+  const SurfacePoint at{*sphere.vf_range(VertexHandle(0)).begin(), {1.0 / 3, 1.0 / 3, 1.0 / 3}};
+  EXPECT_EQ(some.ball(sphere, at, 0.8), all.ball(sphere, at, 0.8));
+  std::vector<int> bump;
+  for (const VertexHandle v : sphere.vertices()) {
+    const Vec3 p = sphere.point(v);
+    const double near = (p - sphere.point(VertexHandle(0))).norm();
+    if (near < 0.35) {
+      bump.push_back(v.idx());
+      sphere.set_point(v, p * (1.0 + 0.3 * (0.35 - near)));
+    }
+  }
+  some.positions_changed(sphere, bump);
+  all.positions_changed();
+  for (const double r : {0.3, 0.8, 1.6}) {
+    const auto expected = all.ball(sphere, at, r);
+    EXPECT_GE(all.last_level(), 1);
+    EXPECT_EQ(some.ball(sphere, at, r), expected) << "radius " << r;
+  }
+}
+
+TEST(Geodesic, CoarseLevelsTakeStrayVerticesComponentsAndHugeRadii) {
+  // Two spheres, and vertices on no face: one far away, one not finite.
+  Mesh mesh = make_icosphere(4, 1.0);
+  const Mesh other = make_icosphere(4, 1.0);
+  std::vector<VertexHandle> added;
+  for (const VertexHandle v : other.vertices())
+    added.push_back(mesh.add_vertex(other.point(v) + Vec3(5, 0, 0)));
+  for (const FaceHandle f : other.faces()) {
+    std::vector<VertexHandle> corners;
+    for (const VertexHandle v : other.fv_range(f)) corners.push_back(added[v.idx()]);
+    mesh.add_face(corners);
+  }
+  mesh.add_vertex(Vec3(1e300, 0, 0));
+  mesh.add_vertex(Vec3(std::numeric_limits<double>::infinity(), 0, 0));
+  FastMarching marching(mesh, {.coarse_ratio = 4});
+  const SurfacePoint at{FaceHandle(0), {0.2, 0.3, 0.5}};
+  const std::size_t sphere = other.n_vertices();
+  for (const double r : {1.0, 10.0, 1e300}) {
+    const auto ball = marching.ball(mesh, at, r);
+    EXPECT_GE(marching.last_level(), 1);
+    for (const auto& [v, d] : ball) {
+      ASSERT_LT(static_cast<std::size_t>(v), sphere) << "the other sphere or a stray vertex";
+      ASSERT_TRUE(std::isfinite(d));
+    }
+    if (r > 4) {
+      EXPECT_EQ(ball.size(), sphere);
+    }
+  }
+  EXPECT_NO_THROW(marching.prepare(mesh, 1e300));
+  EXPECT_THROW(FastMarching(mesh, {.coarse_ratio = 0.5}), InvalidArgument);
+  EXPECT_THROW(FastMarching(mesh, {.coarse_ratio = std::nan("")}), InvalidArgument);
 }
 
 TEST(Geodesic, ACoarseLevelFollowsMovedVerticesAtAStrokesStart) {

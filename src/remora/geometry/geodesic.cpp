@@ -12,8 +12,6 @@ namespace remora {
 
 namespace {
 
-constexpr int kMaxLevel = 40; // cells of 2^40 mean edge lengths: one cluster per component
-
 void check_radius(double radius) {
   if (!(radius >= 0.0) || !std::isfinite(radius))
     throw InvalidArgument(
@@ -28,6 +26,18 @@ std::vector<std::array<int, 3>> face_corners(const Mesh& mesh) {
     triangles.push_back({c[0].idx(), c[1].idx(), c[2].idx()});
   }
   return triangles;
+}
+
+/// The diagonal of the bounding box of the faces' corners with finite coordinates (0: none).
+double corner_diagonal(const Mesh& mesh, const std::vector<std::array<int, 3>>& faces) {
+  Vec3 low(std::numeric_limits<double>::infinity()), high(-std::numeric_limits<double>::infinity());
+  for (const auto& f : faces)
+    for (const int v : f) {
+      const Vec3& p = mesh.points()[static_cast<std::size_t>(v)];
+      if (std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]))
+        low.minimize(p), high.maximize(p);
+    }
+  return low[0] <= high[0] ? (high - low).norm() : 0.0;
 }
 
 double mean_edge_length(const Mesh& mesh) {
@@ -46,14 +56,19 @@ double mean_edge_length(const Mesh& mesh) {
 
 FastMarching::FastMarching(const Mesh& mesh, const FastMarchingOptions& options)
     : faces_(mesh.n_faces()), options_(options) {
-  if (!(options.coarse_ratio >= 0.0) || !std::isfinite(options.coarse_ratio))
-    throw InvalidArgument(
-        fmt::format("geodesic ball: coarse_ratio {} must be finite and >= 0 (0: no coarse levels)",
-                    options.coarse_ratio));
+  if (!(options.coarse_ratio == 0.0 || options.coarse_ratio >= 1.0) ||
+      !std::isfinite(options.coarse_ratio))
+    throw InvalidArgument(fmt::format(
+        "geodesic ball: coarse_ratio {} must be 0 (no coarse levels) or a finite number >= 1",
+        options.coarse_ratio));
   auto corners = face_corners(mesh);
   marcher_ = Marcher(march_rings(mesh.n_vertices(), corners));
   if (options.coarse_ratio > 0.0) {
     mean_edge_ = mean_edge_length(mesh);
+    // The last level's cells span the whole mesh (one cluster per component); larger balls use it.
+    const double diagonal = corner_diagonal(mesh, corners);
+    if (mean_edge_ > 0.0 && std::isfinite(mean_edge_) && diagonal > 0.0 && std::isfinite(diagonal))
+      top_level_ = std::max(1, static_cast<int>(std::ceil(std::log2(diagonal / mean_edge_))));
     corners_ = std::make_shared<const std::vector<std::array<int, 3>>>(std::move(corners));
   }
 }
@@ -75,9 +90,9 @@ void FastMarching::check_mesh(const Mesh& mesh) const {
 
 int FastMarching::level_for(double radius) const {
   const double reach = options_.coarse_ratio * mean_edge_; // the largest radius of level 0
-  if (!(reach > 0.0) || radius <= reach) return 0;
-  const int k = static_cast<int>(std::ceil(std::log2(radius / reach)));
-  return std::clamp(k, 1, kMaxLevel);
+  if (top_level_ == 0 || radius <= reach) return 0;
+  const double k = std::ceil(std::log2(radius / reach)); // in double: the ratio may be huge
+  return k >= top_level_ ? top_level_ : std::max(1, static_cast<int>(k));
 }
 
 std::vector<std::pair<int, double>>

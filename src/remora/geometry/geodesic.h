@@ -12,12 +12,15 @@
 //
 // A large ball may be marched on a coarser level (FastMarchingOptions::coarse_ratio, off by
 // default; geometry/geodesic_levels.h): its cost is then bounded whatever its radius, and its
-// distances lose a little accuracy (within 2 % of the radius on a plane and a sphere; the tests).
+// distances lose a little accuracy: 0.1–0.8 % of the radius on a plane and a sphere with the
+// browser editor's ratio of 64, and the tests bound it at 2 % with ratios of 16 and 32. Near the
+// source they are the level's too: the source's own distance is not exactly 0 there.
 //
 // A brush stroke paints the union of balls of one radius along the pointer's path. Marching each
 // ball in full costs the ball's area per pointer move; a stroke (FastMarching::stroke_ball) marches
 // from the new source only where it comes nearer than every earlier source of the stroke (plus a
-// slack of two edge lengths, which the triangle updates need), and reports only the vertices no
+// slack of two edge lengths, which the triangle updates need; on a coarse level two of its edge
+// lengths plus twice its clusters' spread), and reports only the vertices no
 // earlier ball reached: about half the ball's work for a small step, and an answer of the size of
 // the new crescent. The union of what a stroke reports equals the union of the full balls.
 #pragma once
@@ -40,7 +43,9 @@ struct FastMarchingOptions {
   /// 0: every ball is marched on the mesh itself. Otherwise a ball whose radius exceeds
   /// `coarse_ratio` mean edge lengths is marched on the coarser level whose cells are between
   /// radius / coarse_ratio and twice that (edges of 2^k mean edge lengths, k >= 1), built the
-  /// first time a ball needs it. The browser editor's brush uses 64.
+  /// first time a ball needs it; the last level's cells span the faces' bounding box, and larger
+  /// balls use it. The mean edge length is the constructor's. Must be 0 or >= 1 (else
+  /// InvalidArgument). The browser editor's brush uses 64.
   double coarse_ratio = 0.0;
 };
 
@@ -63,7 +68,8 @@ public:
   /// of vertices and faces differ from the constructor's.
   std::vector<std::pair<int, double>> ball(const Mesh& mesh, const SurfacePoint& source,
                                            double radius);
-  /// The same from a vertex (distance 0 there); InvalidArgument for an invalid or deleted vertex.
+  /// The same from a vertex (distance 0 there, on the mesh itself; a coarse level marches from a
+  /// face at the vertex); InvalidArgument for an invalid or deleted vertex.
   std::vector<std::pair<int, double>> ball(const Mesh& mesh, VertexHandle source, double radius);
 
   /// The next ball of a stroke: the vertices within `radius` of `source` that no earlier ball of
@@ -103,6 +109,7 @@ private:
   std::shared_ptr<const std::vector<std::array<int, 3>>> corners_; ///< the faces', for the levels
   std::vector<std::unique_ptr<CoarseLevel>> levels_; ///< levels_[k - 1], built when first used
   double stroke_radius_ = -1.0;                      ///< < 0: no stroke
+  int top_level_ = 0;                                ///< the coarsest level (0: none)
   int last_level_ = 0;
 };
 

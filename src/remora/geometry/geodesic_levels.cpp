@@ -57,19 +57,31 @@ Groups group(std::size_t groups, const std::vector<std::pair<int, int>>& pairs) 
 std::pair<std::vector<int>, int>
 cluster_vertices(const Mesh& mesh, const std::vector<std::array<int, 3>>& faces, double cell) {
   const std::size_t n = mesh.n_vertices();
+  const Vec3* p = mesh.points();
+  const auto finite = [&](std::size_t v) {
+    return std::isfinite(p[v][0]) && std::isfinite(p[v][1]) && std::isfinite(p[v][2]);
+  };
+  // The cells of the faces' corners with finite coordinates, from their bounding box's corner;
+  // any other vertex is a cluster of its own.
+  std::vector<char> placed(n, 0);
   Vec3 low(std::numeric_limits<double>::infinity());
-  for (std::size_t v = 0; v < n; ++v) low.minimize(mesh.points()[v]);
+  for (const auto& f : faces)
+    for (const int v : f)
+      if (finite(static_cast<std::size_t>(v)))
+        placed[static_cast<std::size_t>(v)] = 1, low.minimize(p[v]);
   std::vector<std::array<std::int64_t, 3>> cell_of(n);
   for (std::size_t v = 0; v < n; ++v)
-    for (int k = 0; k < 3; ++k)
-      cell_of[v][static_cast<std::size_t>(k)] =
-          static_cast<std::int64_t>(std::floor((mesh.points()[v][k] - low[k]) / cell));
+    for (std::size_t k = 0; k < 3 && placed[v]; ++k) // at most 2^62 cells: no overflow
+      cell_of[v][k] = static_cast<std::int64_t>(std::min(
+          std::floor((p[v][static_cast<int>(k)] - low[static_cast<int>(k)]) / cell), 0x1p62));
   std::vector<int> parent(n);
   std::iota(parent.begin(), parent.end(), 0);
   for (const auto& f : faces)
     for (std::size_t k = 0; k < 3; ++k) {
       const int a = f[k], b = f[(k + 1) % 3];
-      if (cell_of[static_cast<std::size_t>(a)] != cell_of[static_cast<std::size_t>(b)]) continue;
+      if (!placed[static_cast<std::size_t>(a)] || !placed[static_cast<std::size_t>(b)] ||
+          cell_of[static_cast<std::size_t>(a)] != cell_of[static_cast<std::size_t>(b)])
+        continue;
       const int ra = find(parent, a), rb = find(parent, b);
       if (ra != rb) parent[static_cast<std::size_t>(std::max(ra, rb))] = std::min(ra, rb);
     }
@@ -232,7 +244,16 @@ void CoarseLevel::start_stroke() {
 std::vector<std::pair<int, double>> CoarseLevel::stroke_ball(const Mesh& mesh, const Vec3& source,
                                                              const std::array<int, 3>& corners,
                                                              double radius) {
-  if (!stroke_started_ && (all_dirty_ || !dirty_.empty())) read_positions(mesh);
+  if (!stroke_started_ && (all_dirty_ || !dirty_.empty())) {
+    read_positions(mesh);
+    // The vertices moved so far that a cluster spreads over several cells (clustered at rest, a
+    // cluster's points are within a cell's diagonal of its mean): cluster them again.
+    if (deviation_ > 2.0 * cell_) {
+      auto faces = faces_;
+      *this = CoarseLevel(mesh, std::move(faces), cell_);
+      read_positions(mesh);
+    }
+  }
   stroke_started_ = true;
   // The clusters of the face's corners and their neighbours start at their straight-line
   // distance: starting from the corners' clusters alone, the front would go through their mean
@@ -266,9 +287,9 @@ std::vector<std::pair<int, double>> CoarseLevel::stroke_ball(const Mesh& mesh, c
       if (reported_[v]) continue;
       const double d = base + in_plane(p[v] - source);
       if (!(d <= radius)) continue;
+      reported_list_.push_back(members_[m]); // first: start_stroke() resets what it lists
       out.emplace_back(members_[m], std::max(d, 0.0));
       reported_[v] = 1;
-      reported_list_.push_back(members_[m]);
       --unreported_[c];
     }
   }

@@ -36,7 +36,8 @@ public:
   std::size_t clusters() const { return marcher_.size(); }
 
   /// The positions of `vertices` (or of every vertex) changed: their clusters are read again at
-  /// the next stroke's start.
+  /// the next stroke's start (a cluster whose vertices spread beyond twice the cell from their
+  /// mean: the level clusters the moved mesh again).
   void positions_changed(const Mesh& mesh, const std::vector<int>& vertices);
   void positions_changed();
 

@@ -89,11 +89,11 @@ std::vector<Accepted> Marcher::march(const Vec3* points,
     // by more than the slack, no vertex beyond it is new.
     if (!(d < distance_[i]) || d > radius || !(d < nearest_[i] + slack)) return;
     if (state_[i] == kFar) {
+      touched_.push_back(v); // first: a throw leaves nothing that the next march does not reset
       state_[i] = kTrial;
-      touched_.push_back(v);
     }
-    distance_[i] = d;
     front.push({d, v});
+    distance_[i] = d;
   };
   for (const auto& [v, d] : seeds) offer(v, d);
   std::vector<Accepted> out;
@@ -104,10 +104,10 @@ std::vector<Accepted> Marcher::march(const Vec3* points,
     front.pop();
     const auto i = static_cast<std::size_t>(v);
     if (state_[i] == kAccepted || d > distance_[i]) continue; // a stale entry
-    state_[i] = kAccepted;
     const bool fresh = nearest_[i] == kInf;
     if (fresh) stroke_touched_.push_back(v);
     out.push_back({v, d, fresh});
+    state_[i] = kAccepted;
     nearest_[i] = std::min(nearest_[i], d);
     const Vec3& pv = points[i];
     for (std::uint32_t r = begin[i]; r < begin[i + 1]; ++r) {
