@@ -6,6 +6,7 @@
 #include <numbers>
 #include <random>
 #include <sstream>
+#include <vector>
 
 #include <Eigen/Core>
 
@@ -29,6 +30,19 @@ inline Vec3 random_vector(std::mt19937& rng, double scale) {
 }
 
 /// The largest distance between corresponding rows of two n×3 matrices.
+/// Adds `other`'s vertices (moved by `offset`) and faces to `mesh`: a second component.
+inline void append_component(Mesh& mesh, const Mesh& other, const Vec3& offset) {
+  std::vector<VertexHandle> added;
+  for (const VertexHandle v : other.vertices())
+    added.push_back(mesh.add_vertex(other.point(v) + offset));
+  for (const FaceHandle f : other.faces()) {
+    std::vector<VertexHandle> corners;
+    for (const VertexHandle v : other.fv_range(f))
+      corners.push_back(added[static_cast<std::size_t>(v.idx())]);
+    mesh.add_face(corners);
+  }
+}
+
 inline double max_row_distance(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
   return (a - b).rowwise().norm().maxCoeff();
 }

@@ -26,6 +26,7 @@
 namespace remora {
 namespace {
 
+using testing::append_component;
 using testing::kPi;
 using testing::max_row_distance;
 
@@ -326,16 +327,7 @@ TEST(Editor, ErrorsNameTheProblem) {
   // A support covering a whole component with no constrained vertex: two spheres, the handle on
   // one, the whole other one painted.
   Mesh two = make_icosphere(2, 1.0);
-  const Mesh other = make_icosphere(2, 1.0);
-  std::vector<VertexHandle> map;
-  for (const VertexHandle v : other.vertices())
-    map.push_back(two.add_vertex(other.point(v) + Vec3(5, 0, 0)));
-  for (const FaceHandle f : other.faces()) {
-    std::vector<VertexHandle> fv;
-    for (const VertexHandle v : other.fv_range(f))
-      fv.push_back(map[static_cast<std::size_t>(v.idx())]);
-    two.add_face(fv);
-  }
+  append_component(two, make_icosphere(2, 1.0), Vec3(5, 0, 0));
   Editor pair(two);
   std::vector<int> painted = select_sphere(two, Vec3(5, 0, 0), 1.5);
   const auto first = select_sphere(two, Vec3(0, 0, 1), 0.5);

@@ -13,6 +13,7 @@
 #include "remora/geometry/selection.h"
 #include "remora/mesh/io.h"
 #include "remora/mesh/primitives.h"
+#include "support.h"
 
 namespace remora {
 namespace {
@@ -114,14 +115,7 @@ TEST(Geodesic, OneMarcherGivesTheSameBallsAsFreshOnesAndFollowsMovedVertices) {
   // Two spheres in one mesh: a ball larger than either reaches one sphere only.
   Mesh two = make_icosphere(2, 1.0);
   const Mesh other = make_icosphere(2, 1.0);
-  std::vector<VertexHandle> added;
-  for (const VertexHandle v : other.vertices())
-    added.push_back(two.add_vertex(other.point(v) + Vec3(5, 0, 0)));
-  for (const FaceHandle f : other.faces()) {
-    std::vector<VertexHandle> corners;
-    for (const VertexHandle v : other.fv_range(f)) corners.push_back(added[v.idx()]);
-    two.add_face(corners);
-  }
+  testing::append_component(two, other, Vec3(5, 0, 0));
   EXPECT_EQ(geodesic_ball(two, VertexHandle(0), 100.0).size(), other.n_vertices());
 }
 
@@ -311,14 +305,7 @@ TEST(Geodesic, CoarseLevelsTakeStrayVerticesComponentsAndHugeRadii) {
   // Two spheres, and vertices on no face: one far away, one not finite.
   Mesh mesh = make_icosphere(4, 1.0);
   const Mesh other = make_icosphere(4, 1.0);
-  std::vector<VertexHandle> added;
-  for (const VertexHandle v : other.vertices())
-    added.push_back(mesh.add_vertex(other.point(v) + Vec3(5, 0, 0)));
-  for (const FaceHandle f : other.faces()) {
-    std::vector<VertexHandle> corners;
-    for (const VertexHandle v : other.fv_range(f)) corners.push_back(added[v.idx()]);
-    mesh.add_face(corners);
-  }
+  testing::append_component(mesh, other, Vec3(5, 0, 0));
   mesh.add_vertex(Vec3(1e300, 0, 0));
   mesh.add_vertex(Vec3(std::numeric_limits<double>::infinity(), 0, 0));
   FastMarching marching(mesh, {.coarse_ratio = 4});
