@@ -2,9 +2,12 @@
 //
 // The fine mesh's vertices are clustered: a cluster is a set of vertices in one cell of a cubic
 // grid that the mesh's edges inside the cell connect (two sheets of a thin part that share a cell
-// stay apart). A fine triangle whose corners lie in three clusters is a coarse triangle, an edge
-// between two clusters on no such triangle a coarse edge. The front marches on the clusters'
-// mean points; a fine vertex v of a cluster C at coarse distance d(C) then gets
+// stay apart). Two clusters are adjacent where an edge joins them, and every three pairwise
+// adjacent clusters are a coarse triangle (where four meet, both diagonals of their
+// quadrilateral); an adjacency on no triangle is a lone edge. The front starts at the clusters
+// of the source's face and their neighbours, at their straight-line distance from the source,
+// and marches on the clusters' mean points; a fine vertex v of a cluster C at coarse distance
+// d(C) then gets
 //   d(v) = d(C) + |P(v − s)| − |P(c − s)|   (s the source, c the mean point of C, P the
 //   projection on C's tangent plane),
 // the coarse distance carried to v to first order: the projected direction from s is the
@@ -43,7 +46,8 @@ public:
 
   /// As FastMarching::stroke_ball, from the point `source` on the face with corners `corners`:
   /// the fine vertices within `radius` that no earlier ball of the stroke reported, with their
-  /// distances, in increasing order. The first call after start_stroke() reads the positions.
+  /// distances, in increasing order. The first call after start_stroke() reads the positions of
+  /// the clusters that changed.
   std::vector<std::pair<int, double>> stroke_ball(const Mesh& mesh, const Vec3& source,
                                                   const std::array<int, 3>& corners, double radius);
   void start_stroke();
