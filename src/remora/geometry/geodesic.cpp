@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "remora/common/error.h"
+#include "remora/geometry/measures.h"
 
 namespace remora {
 
@@ -38,18 +39,6 @@ double corner_diagonal(const Mesh& mesh, const std::vector<std::array<int, 3>>& 
         low.minimize(p), high.maximize(p);
     }
   return low[0] <= high[0] ? (high - low).norm() : 0.0;
-}
-
-double mean_edge_length(const Mesh& mesh) {
-  double sum = 0.0;
-  std::size_t count = 0;
-  for (const FaceHandle f : mesh.faces()) {
-    const auto c = face_vertices(mesh, f);
-    for (std::size_t k = 0; k < 3; ++k)
-      sum += (mesh.point(c[k]) - mesh.point(c[(k + 1) % 3])).norm();
-    count += 3;
-  }
-  return count > 0 ? sum / static_cast<double>(count) : 0.0;
 }
 
 } // namespace

@@ -87,7 +87,7 @@ struct TriangleHit {
 // Möller–Trumbore: false when the ray is parallel to the plane of (a, b, c) or misses the
 // triangle by more than a relative 1e-12 on the barycentrics; any t is returned.
 bool meet_triangle(const Ray& ray, const Vec3& a, const Vec3& b, const Vec3& c, TriangleHit& out) {
-  constexpr double kTolerance = 1e-12;
+  constexpr double kBaryTolerance = 1e-12;
   const Vec3 ab = b - a;
   const Vec3 ac = c - a;
   const Vec3 p = OpenMesh::cross(ray.direction, ac);
@@ -96,10 +96,10 @@ bool meet_triangle(const Ray& ray, const Vec3& a, const Vec3& b, const Vec3& c, 
   const double inv_det = 1.0 / det;
   const Vec3 s = ray.origin - a;
   const double u = OpenMesh::dot(s, p) * inv_det;
-  if (u < -kTolerance || u > 1.0 + kTolerance) return false;
+  if (u < -kBaryTolerance || u > 1.0 + kBaryTolerance) return false;
   const Vec3 q = OpenMesh::cross(s, ab);
   const double v = OpenMesh::dot(ray.direction, q) * inv_det;
-  if (v < -kTolerance || u + v > 1.0 + kTolerance) return false;
+  if (v < -kBaryTolerance || u + v > 1.0 + kBaryTolerance) return false;
   out = {OpenMesh::dot(ac, q) * inv_det, u, v};
   return true;
 }
