@@ -5,6 +5,7 @@
 #include <limits>
 #include <numbers>
 #include <numeric>
+#include <random>
 
 #include <gtest/gtest.h>
 
@@ -274,6 +275,42 @@ TEST(Geodesic, ACoarseStrokeOfLongStepsStillReportsTheUnion) {
   std::vector<SurfacePoint> far;
   for (std::size_t i = 0; i < along.size(); i += 8) far.push_back(along[i]);
   expect_stroke_is_the_union_of_balls(bunny, far, 0.05, levels);
+}
+
+TEST(Geodesic, RandomCoarseStrokesOnAScanReportTheUnion) {
+  // Seeded strokes from random vertices in random directions, with random radii and steps of 1
+  // to 12 edges, on levels from 2 mean edge lengths: the slack's argument is not a proof.
+  const Mesh bunny = read_mesh(std::string(REMORA_REPO_DATA) + "/bunny.ply").mesh;
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> radius(0.003, 0.045);
+  std::uniform_int_distribution<int> vertex(0, static_cast<int>(bunny.n_vertices()) - 1),
+      step(1, 12);
+  std::normal_distribution<double> normal;
+  for (int trial = 0; trial < 12; ++trial) {
+    const double r = radius(rng);
+    const int edges = step(rng);
+    const Vec3 toward(normal(rng), normal(rng), normal(rng));
+    std::vector<SurfacePoint> path;
+    VertexHandle v(vertex(rng));
+    for (int s = 0; s < 20; ++s) {
+      const FaceHandle f = *bunny.vf_range(v).begin();
+      const auto corners = face_vertices(bunny, f);
+      std::array<double, 3> bary{};
+      for (std::size_t k = 0; k < 3; ++k) bary[k] = corners[k] == v ? 1.0 : 0.0;
+      path.push_back({f, bary});
+      for (int e = 0; e < edges; ++e) {
+        VertexHandle next = v;
+        double ahead = -std::numeric_limits<double>::infinity();
+        for (const VertexHandle w : bunny.vv_range(v))
+          if (const double d = OpenMesh::dot(bunny.point(w) - bunny.point(v), toward); d > ahead)
+            ahead = d, next = w;
+        v = next;
+      }
+    }
+    SCOPED_TRACE(::testing::Message()
+                 << "trial " << trial << ", radius " << r << ", steps of " << edges);
+    expect_stroke_is_the_union_of_balls(bunny, path, r, {.coarse_ratio = 2});
+  }
 }
 
 TEST(Geodesic, ACoarseLevelToldOfSomeMovedVerticesEqualsOneToldOfAll) {
