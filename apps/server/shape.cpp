@@ -20,16 +20,11 @@ Brush parse_brush(const std::string& name) {
 
 // The caster and the brush's coarse levels are built here, on the load's worker, not on the
 // first pick (half a second and a few tenths on a million triangles). The levels are those of
-// every brush up to the page's largest, the radius of the bounding sphere.
+// every brush up to half the diagonal of the faces' bounding box, which the page's largest (its
+// bounding sphere's radius) does not exceed.
 Shape::Shape(const Mesh& mesh, double coarse_ratio)
     : mesh_(mesh), caster_(mesh_), marching_(mesh_, {.coarse_ratio = coarse_ratio}) {
-  // The faces' corners only (the caster has checked that they are finite): a stray vertex on no
-  // face does not widen the page's brush.
-  Vec3 low(std::numeric_limits<double>::infinity()), high(-low);
-  for (const FaceHandle f : mesh_.faces())
-    for (const VertexHandle v : mesh_.fv_range(f))
-      low.minimize(mesh_.point(v)), high.maximize(mesh_.point(v));
-  if (mesh_.n_faces() > 0) marching_.prepare(mesh_, 0.5 * (high - low).norm());
+  marching_.prepare(mesh_, 0.5 * marching_.faces_diagonal());
 }
 
 void Shape::set_positions(const Eigen::MatrixXd& positions) {

@@ -55,9 +55,10 @@ FastMarching::FastMarching(const Mesh& mesh, const FastMarchingOptions& options)
   if (options.coarse_ratio > 0.0) {
     mean_edge_ = mean_edge_length(mesh);
     // The last level's cells span the whole mesh (one cluster per component); larger balls use it.
-    const double diagonal = corner_diagonal(mesh, corners);
-    if (mean_edge_ > 0.0 && std::isfinite(mean_edge_) && diagonal > 0.0 && std::isfinite(diagonal))
-      top_level_ = std::max(1, static_cast<int>(std::ceil(std::log2(diagonal / mean_edge_))));
+    diagonal_ = corner_diagonal(mesh, corners);
+    if (mean_edge_ > 0.0 && std::isfinite(mean_edge_) && diagonal_ > 0.0 &&
+        std::isfinite(diagonal_))
+      top_level_ = std::max(1, static_cast<int>(std::ceil(std::log2(diagonal_ / mean_edge_))));
     corners_ = std::make_shared<const std::vector<std::array<int, 3>>>(std::move(corners));
   }
 }
@@ -120,8 +121,23 @@ void FastMarching::positions_changed(const Mesh& mesh, const std::vector<int>& v
   for (const int v : vertices)
     if (v < 0 || static_cast<std::size_t>(v) >= mesh.n_vertices())
       throw InvalidArgument(fmt::format("geodesic ball: vertex {} is not a vertex of the mesh", v));
+  if (std::none_of(levels_.begin(), levels_.end(),
+                   [](const auto& level) { return level && !level->reads_all(); }))
+    return;
+  // The moved vertices and their neighbours (a face's normal changes with any of its corners),
+  // once for every level.
+  near_moved_.assign(mesh.n_vertices(), 0);
+  std::vector<int> near;
+  const auto add = [&](int v) {
+    if (!near_moved_[static_cast<std::size_t>(v)])
+      near_moved_[static_cast<std::size_t>(v)] = 1, near.push_back(v);
+  };
+  for (const int v : vertices) {
+    add(v);
+    for (const VertexHandle w : mesh.vv_range(VertexHandle(v))) add(w.idx());
+  }
   for (const auto& level : levels_)
-    if (level) level->positions_changed(mesh, vertices);
+    if (level) level->positions_changed(near);
 }
 
 void FastMarching::positions_changed() {

@@ -85,6 +85,9 @@ public:
   /// Builds now the coarse levels that balls of radius up to `radius` need (otherwise each is
   /// built by the first ball that needs it: 0.1–0.3 s on a million triangles).
   void prepare(const Mesh& mesh, double radius);
+  /// The diagonal of the bounding box of the faces' finite corners at construction (with
+  /// coarse levels; 0 without).
+  double faces_diagonal() const { return diagonal_; }
 
   /// `vertices` of `mesh` (or all of them) moved: the coarse levels read their clusters again
   /// at the next stroke's start. Not needed for balls on the mesh itself.
@@ -109,7 +112,9 @@ private:
   std::shared_ptr<const std::vector<std::array<int, 3>>> corners_; ///< the faces', for the levels
   std::vector<std::unique_ptr<CoarseLevel>> levels_; ///< levels_[k - 1], built when first used
   double stroke_radius_ = -1.0;                      ///< < 0: no stroke
-  int top_level_ = 0;                                ///< the coarsest level (0: none)
+  double diagonal_ = 0.0;
+  int top_level_ = 0;            ///< the coarsest level (0: none)
+  std::vector<char> near_moved_; ///< positions_changed()'s scratch
   int last_level_ = 0;
 };
 

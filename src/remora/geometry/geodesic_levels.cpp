@@ -182,16 +182,11 @@ void CoarseLevel::positions_changed() {
   all_dirty_ = true;
 }
 
-void CoarseLevel::positions_changed(const Mesh& mesh, const std::vector<int>& vertices) {
+void CoarseLevel::positions_changed(const std::vector<int>& vertices) {
   if (all_dirty_) return;
-  const auto mark = [&](int v) {
+  for (const int v : vertices) {
     const auto c = static_cast<std::size_t>(cluster_of_[static_cast<std::size_t>(v)]);
     if (!dirty_flag_[c]) dirty_flag_[c] = 1, dirty_.push_back(static_cast<int>(c));
-  };
-  for (const int v : vertices) {
-    mark(v);
-    // A face's area vector changes with any of its corners: its clusters' normals too.
-    for (const VertexHandle w : mesh.vv_range(VertexHandle(v))) mark(w.idx());
   }
 }
 

@@ -38,11 +38,14 @@ public:
   double cell() const { return cell_; }
   std::size_t clusters() const { return marcher_.size(); }
 
-  /// The positions of `vertices` (or of every vertex) changed: their clusters are read again at
-  /// the next stroke's start (a cluster whose vertices spread beyond twice the cell from their
-  /// mean: the level clusters the moved mesh again).
-  void positions_changed(const Mesh& mesh, const std::vector<int>& vertices);
+  /// `vertices` moved or have a neighbour that did (or every vertex moved): their clusters'
+  /// points, spreads and normals are read again at the next stroke's start (a cluster whose
+  /// vertices spread beyond twice the cell from their mean: the level clusters the moved mesh
+  /// again).
+  void positions_changed(const std::vector<int>& vertices);
   void positions_changed();
+  /// Whether the next stroke reads every cluster again anyway.
+  bool reads_all() const { return all_dirty_; }
 
   /// As FastMarching::stroke_ball, from the point `source` on the face with corners `corners`:
   /// the fine vertices within `radius` that no earlier ball of the stroke reported, with their
