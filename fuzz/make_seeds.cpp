@@ -365,8 +365,16 @@ void server_seeds(const fs::path& out) {
   }
   const std::string region =
       nlohmann::json{{"support", support}, {"handles", {handle}}, {"k", 2}}.dump();
+  // The nonlinear region's support as ranges of consecutive ids, as the page sends it.
+  nlohmann::json ranges = nlohmann::json::array();
+  for (std::size_t i = 0; i < support.size();) {
+    std::size_t j = i + 1;
+    while (j < support.size() && support[j] == support[j - 1] + 1) ++j;
+    ranges.push_back({support[i], j - i});
+    i = j;
+  }
   const std::string nonlinear = nlohmann::json{
-      {"support", support},
+      {"support", {{"ranges", ranges}}},
       {"handles", {handle}},
       {"k", 2},
       {"method", "nonlinear"}}.dump();

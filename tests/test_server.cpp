@@ -208,6 +208,64 @@ TEST(Server, EditRoundTripWithUndoAndRedo) {
 
 // The export is the mesh I/O layer's memory writer on the current result, byte for byte, and
 // needs no file: it works without a usable temporary folder.
+/// `ids` as ranges of consecutive ids: [[first, count], ...].
+json as_ranges(const std::vector<int>& ids) {
+  json ranges = json::array();
+  for (std::size_t i = 0; i < ids.size();) {
+    std::size_t j = i + 1;
+    while (j < ids.size() && ids[j] == ids[j - 1] + 1) ++j;
+    ranges.push_back({ids[i], j - i});
+    i = j;
+  }
+  return {{"ranges", ranges}};
+}
+
+TEST(Server, ARegionSentAsRangesIsTheRegionOfTheIdsTheyList) {
+  Session s;
+  ASSERT_EQ(call(s, "POST", "/api/load", sphere_off(), {{"name", "sphere.off"}}).status, 202);
+  s.wait();
+  const auto rest = as<float>(call(s, "GET", "/api/mesh/positions"));
+  std::vector<int> support, handle;
+  for (std::size_t v = 0; v < rest.size() / 3; ++v) {
+    if (rest[3 * v + 2] > 0.2) support.push_back(static_cast<int>(v));
+    if (rest[3 * v + 2] > 0.9) handle.push_back(static_cast<int>(v));
+  }
+  const json ranges = as_ranges(support);
+  ASSERT_GT(ranges["ranges"].size(), 1u); // several ranges, some longer than one id
+  ASSERT_LT(ranges["ranges"].size(), support.size());
+  // The support as ranges, the handle as ids: the server lists the same ids back.
+  ASSERT_EQ(call(s, "POST", "/api/region", json{{"support", ranges}, {"handles", {handle}}}.dump())
+                .status,
+            202);
+  s.wait();
+  const json status = json::parse(call(s, "GET", "/api/status").body);
+  ASSERT_FALSE(status.contains("error")) << status;
+  const json region = json::parse(call(s, "GET", "/api/region").body);
+  EXPECT_EQ(region["support"].get<std::vector<int>>(), support);
+  EXPECT_EQ(region["handles"][0].get<std::vector<int>>(), handle);
+  // Bad ranges are 400s that name the range; the region stays.
+  const auto refused = [&](const std::string& support_json, const std::string& part,
+                           const ApiLimits& limits = {}) {
+    const std::string body = R"({"support": )" + support_json + R"(, "handles": [[0]]})";
+    const HttpResponse r = handle_api(s, HttpRequest{"POST", "/api/region", {}, body}, limits);
+    expect_error(r, 400, part);
+  };
+  refused(R"({"ranges": [[0, 0]]})", "support.ranges[0]");
+  refused(R"({"ranges": [[1, 2], [-1, 2]]})", "support.ranges[1]");
+  refused(R"({"ranges": [[0]]})", "support.ranges[0]");
+  refused(R"({"ranges": [[2147483647, 2]]})", "support.ranges[0]");
+  refused(R"({"ranges": [[0, 1.5]]})", "support.ranges[0]");
+  refused(R"({"ranges": [[0, 2]], "more": 1})", "support: expected");
+  refused(R"({"ids": [1]})", "support: expected");
+  refused(R"({"ranges": [[0, 1000000000]]})", "more ids than the request can carry");
+  ApiLimits small;
+  small.max_json_bytes = 200; // at most 100 ids over the request
+  refused(R"({"ranges": [[0, 60], [100, 60]]})", "support.ranges[1]", small);
+  refused(R"({"ranges": [[0, 700]]})", "more ids", {}); // within the budget: the session's bound
+  EXPECT_EQ(json::parse(call(s, "GET", "/api/region").body)["support"].get<std::vector<int>>(),
+            support);
+}
+
 TEST(Server, ExportIsTheMemoryWriterAndNeedsNoTemporaryFolder) {
   Session s;
   const std::string off = sphere_off();

@@ -54,6 +54,22 @@ export const binary = async (path, Type) => new Type(await (await api(path)).arr
 export const post = (path, body) => api(path, { method: 'POST', headers: { 'Content-Type': 'application/json' },
                                                 body: JSON.stringify(body ?? {}) });
 
+/// Vertex ids (increasing; an array or a typed array) as POST /api/region takes them: {ranges: [[first, count], ...]}, runs
+/// of consecutive ids, when there are at most half as many runs as ids (a scan's or a subdivided
+/// mesh's vertex order keeps neighbours together: a 31k-vertex support of igea_sub4 is about 600
+/// runs), else the ids themselves. A smaller body travels faster: chromium takes far longer for a
+/// request body of 256 KB than of 128 KB.
+export function compactIds(ids) {
+  const ranges = [];
+  for (let i = 0; i < ids.length;) {
+    let j = i + 1;
+    while (j < ids.length && ids[j] === ids[j - 1] + 1) ++j;
+    ranges.push([ids[i], j - i]);
+    i = j;
+  }
+  return 2 * ranges.length <= ids.length ? { ranges } : Array.from(ids);
+}
+
 /// Polls the status until the server is not busy; calls onBusy(status) on every busy answer and
 /// returns the first other status. A job's error (status.error) is shown.
 export async function waitUntilReady(onBusy) {

@@ -5,7 +5,7 @@
 // view.js draws, api.js talks to the server, picking.js asks it what is under the pointer,
 // panels.js is the panel and the keyboard.
 import * as THREE from 'three';
-import { ApiError, api, binary, json, message, post, task, waitUntilReady, work } from './api.js';
+import { ApiError, api, binary, compactIds, json, message, post, task, waitUntilReady, work } from './api.js';
 import * as view from './view.js';
 import { FIXED, FREE } from './view.js';
 import { Coalescer, faceNormal, pick } from './picking.js';
@@ -249,17 +249,18 @@ function strokeChanged() {
 /// The painted region as the API takes it; handles are renumbered so that none is empty (the
 /// labels follow), and `free` counts the support's vertices outside every handle.
 function regionLists() {
-  // One index loop over the typed array (it runs once per stroke over every vertex, mostly
-  // before the JIT has optimized it), then one over the support.
+  // One index loop over the labels into a typed array (it runs once per stroke over every vertex,
+  // mostly before the JIT has optimized it), then one over the support.
   const labels = state.labels, n = labels.length;
-  const counts = new Array(state.handleCount).fill(0), support = [];
-  let free = 0;
+  const counts = new Array(state.handleCount).fill(0), all = new Uint32Array(n);
+  let free = 0, m = 0;
   for (let v = 0; v < n; ++v) {
     const l = labels[v];
     if (l === FIXED) continue;
-    support.push(v);
+    all[m++] = v;
     if (l >= 0) counts[l] += 1; else free += 1;
   }
+  const support = all.slice(0, m);
   const renumber = [];
   let kept = 0;
   counts.forEach((c, j) => { renumber[j] = c > 0 ? kept++ : -1; });
@@ -300,10 +301,11 @@ async function sendRegion({ keepGizmo = false, inStroke = false } = {}) {
   }
   if (busy() && state.status?.progress?.job !== 'region') await settle(); // a load: wait for it
   const steps = { started, lists: performance.now() };
-  const posted = post('region', { support, handles, k: state.k, ...methodRequest(state.method) });
+  const posted = post('region', { support: compactIds(support), handles: handles.map(compactIds), k: state.k,
+                                  ...methodRequest(state.method) });
   // While the request travels and the server solves: the normal plan of the region sent (its
   // movable vertices are the support, handles included, sorted).
-  state.sentMovable = Uint32Array.from(support);
+  state.sentMovable = support;
   view.setMovable(state.sentMovable);
   steps.planned = performance.now();
   const outcome = (async () => {

@@ -1,5 +1,6 @@
 #include "api.h"
 
+#include <algorithm>
 #include <cctype>
 #include <charconv>
 #include <chrono>
@@ -71,16 +72,47 @@ json parse_json(const HttpRequest& request, const ApiLimits& limits) {
   }
 }
 
-std::vector<int> ids(const json& j, const std::string& path) {
-  if (!j.is_array()) throw BadRequest(path + ": expected an array of vertex ids");
+/// A list of vertex ids: an array of ids, or {"ranges": [[first, count], ...]} for the ids first,
+/// first + 1, ..., first + count - 1 of each range in turn. `budget` bounds the ids that ranges may
+/// expand to over the whole request (what arrays in a body of the same size could hold) and is
+/// decreased by each list read.
+std::vector<int> ids(const json& j, const std::string& path, std::size_t& budget) {
+  constexpr long long kMaxId = 2147483647LL;
   std::vector<int> out;
+  if (j.is_object()) {
+    if (j.size() != 1 || !j.contains("ranges") || !j.at("ranges").is_array())
+      throw BadRequest(path + ": expected an array of vertex ids or {\"ranges\": [[first, count], "
+                              "...]}");
+    const json& ranges = j.at("ranges");
+    for (std::size_t i = 0; i < ranges.size(); ++i) {
+      const json& r = ranges[i];
+      const auto integer = [](const json& x) { return x.is_number_integer(); };
+      if (!r.is_array() || r.size() != 2 || !integer(r[0]) || !integer(r[1]) ||
+          r[0].get<long long>() < 0 || r[1].get<long long>() < 1 ||
+          r[0].get<long long>() > kMaxId - r[1].get<long long>() + 1)
+        throw BadRequest(fmt::format("{}.ranges[{}]: expected [first, count], first >= 0, count "
+                                     ">= 1, first + count - 1 a vertex id",
+                                     path, i));
+      const auto first = r[0].get<long long>(), count = r[1].get<long long>();
+      if (static_cast<unsigned long long>(count) > budget)
+        throw BadRequest(fmt::format("{}.ranges[{}]: the ranges list more ids than the request "
+                                     "can carry",
+                                     path, i));
+      budget -= static_cast<std::size_t>(count);
+      for (long long v = first; v < first + count; ++v) out.push_back(static_cast<int>(v));
+    }
+    return out;
+  }
+  if (!j.is_array())
+    throw BadRequest(path + ": expected an array of vertex ids or {\"ranges\": [[first, count], "
+                            "...]}");
   out.reserve(j.size());
   for (std::size_t i = 0; i < j.size(); ++i) {
-    if (!j[i].is_number_integer() || j[i].get<long long>() < 0 ||
-        j[i].get<long long>() > 2147483647LL)
+    if (!j[i].is_number_integer() || j[i].get<long long>() < 0 || j[i].get<long long>() > kMaxId)
       throw BadRequest(fmt::format("{}[{}]: expected a vertex id (an integer >= 0)", path, i));
     out.push_back(j[i].get<int>());
   }
+  budget -= std::min(budget, out.size());
   return out;
 }
 
@@ -99,12 +131,13 @@ HttpResponse region(Session& session, const HttpRequest& request, const ApiLimit
   if (!j.contains("support") || !j.contains("handles"))
     throw BadRequest("expected {\"support\": [ids], \"handles\": [[ids], ...], \"k\": 1|2|3, "
                      "\"method\": \"linear\"|\"nonlinear\", \"energy\": name}");
-  std::vector<int> support = ids(j.at("support"), "support");
+  std::size_t budget = limits.max_json_bytes / 2; // "0," per id in an array
+  std::vector<int> support = ids(j.at("support"), "support", budget);
   const json& hs = j.at("handles");
-  if (!hs.is_array()) throw BadRequest("handles: expected an array of arrays of vertex ids");
+  if (!hs.is_array()) throw BadRequest("handles: expected an array of lists of vertex ids");
   std::vector<std::vector<int>> handles;
   for (std::size_t i = 0; i < hs.size(); ++i)
-    handles.push_back(ids(hs[i], fmt::format("handles[{}]", i)));
+    handles.push_back(ids(hs[i], fmt::format("handles[{}]", i), budget));
   int k = 2;
   if (j.contains("k")) {
     if (!j.at("k").is_number_integer()) throw BadRequest("k: expected 1, 2 or 3");

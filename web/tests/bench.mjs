@@ -28,13 +28,15 @@
 //
 //   node web/tests/bench.mjs --cli build/bin/remora --web-root build/web [--mesh data/bunny.ply]
 //        [--support-radius R] [--moves N] [--method linear|nonlinear|blended-motions] [--quick]
-//        [--server-frames] [--kernel js] [--sphere-brush] [--support-count N]
+//        [--server-frames] [--kernel js] [--sphere-brush] [--support-count N] [--trace FILE]
 // R is in the mesh's units (default: a fifth of its bounding radius); the support is painted at
 // the surface under the view's centre. --method: the page's method switch, set before the support
 // is painted (default linear). --quick: no drawn figures and no bake (their keys are
 // null). --sphere-brush: the brushes take the straight-line distance (the far side too: the
 // largest supports). --support-count N: instead of the support's strokes, the N vertices
-// nearest the camera (no paint figures). Exit code 0: done, 1: failed, 77: chromium or playwright-core missing.
+// nearest the camera (no paint figures). --trace FILE: chromium's trace of the handle stroke
+// until the manipulator (JSON for Perfetto or chrome://tracing: the page's tasks, its requests,
+// the garbage collector). Exit code 0: done, 1: failed, 77: chromium or playwright-core missing.
 import { args, chromiumOrSkip, client, drag, ready, startServer } from './harness.mjs';
 
 const moves = Number(args.moves ?? 30);
@@ -85,8 +87,12 @@ try {
   await page.keyboard.press('h');
   await page.evaluate((r) => window.remora.setRadius(r / 4), supportRadius);
   await page.evaluate(() => window.remora.setDrawing(false));
+  if (args.trace) {
+    await browser.startTracing(page, { path: args.trace, categories: ['devtools.timeline', 'disabled-by-default-devtools.timeline', 'v8', 'blink', 'toplevel', 'loading'] });
+  }
   await drag(page, centre.x, centre.y, 1, 0, 3);
   await ready(page, 600000);
+  if (args.trace) await browser.stopTracing();
   await page.evaluate(() => window.remora.setDrawing(true));
   let m = await marks();
   const mouseupToGizmo = m.regionReady[m.regionReady.length - 1] - m.strokeEnd;
