@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstddef>
+#include <exception>
 
 #include <omp.h>
 
@@ -28,6 +29,33 @@ void parallel_blocks(std::size_t n, int threads, Body&& body) {
   const int team = threads > 0 ? threads : omp_get_max_threads();
 #pragma omp parallel for schedule(dynamic, 1) num_threads(team) if (team > 1 && n > 1)
   for (long i = 0; i < count; ++i) body(static_cast<std::size_t>(i));
+}
+
+/// Runs body() so that the OpenMP parallel regions it opens run on one thread, for a library whose
+/// regions we cannot size: body() runs as the master of an active two-thread region, and libgomp
+/// runs the regions nested in it on one thread (its max-active-levels is 1 unless
+/// OMP_MAX_ACTIVE_LEVELS or OMP_NESTED raise it). The other thread waits at the region's end,
+/// asleep after a short spin. Inside an active region already, body() runs as it is. What
+/// body() throws is rethrown here.
+template <class Body>
+void with_serial_openmp(Body&& body) {
+  if (omp_get_active_level() > 0) {
+    body();
+    return;
+  }
+  std::exception_ptr error;
+#pragma omp parallel num_threads(2)
+  {
+#pragma omp master
+    {
+      try {
+        body();
+      } catch (...) {
+        error = std::current_exception();
+      }
+    }
+  }
+  if (error) std::rethrow_exception(error);
 }
 
 } // namespace remora

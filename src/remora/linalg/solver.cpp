@@ -17,6 +17,7 @@
 #endif
 
 #include "remora/common/error.h"
+#include "remora/common/parallel.h"
 #include "remora/linalg/blas_threads.h"
 
 extern "C" {
@@ -130,7 +131,9 @@ public:
     small_ = llt_.cholmod().fl < kThreadedBlasFlops;
     std::optional<BlasThreadsScope> one_blas_thread;
     if (small_) one_blas_thread.emplace();
-    llt_.factorize(a);
+    // CHOLMOD 3 opens an OpenMP region of 4 threads for small loops of every supernode (zeroing,
+    // scattering); their wake-ups doubled a mesh's factorization (docs/solvers.md).
+    with_serial_openmp([&] { llt_.factorize(a); });
     const cholmod_factor* l = llt_.factor();
     if (llt_.info() != Eigen::Success || l == nullptr || l->minor < l->n)
       throw NumericalError(not_spd("cholmod"));
