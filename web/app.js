@@ -109,14 +109,10 @@ async function fetchRegion(s, labelsKnown) {
     view.colour(state.labels);
   }
   state.serverHandles = s.region?.handles ?? 0;
-  if (labelsKnown && s.region && state.sentMovable) {
-    // The movable vertices are the support the page sent (sorted, handles included); its normal
-    // plan was made while the server solved.
-    state.movable = state.sentMovable;
-  } else {
-    state.movable = s.region ? await binary('movable', Uint32Array) : null;
-    view.setMovable(state.movable);
-  }
+  // The movable vertices are the support the page sent (sorted, handles included).
+  if (labelsKnown && s.region && state.sentMovable) state.movable = state.sentMovable;
+  else state.movable = s.region ? await binary('movable', Uint32Array) : null;
+  view.setMovable(state.movable);
   state.sentMovable = null;
   state.held.region = s.region_id;
   loadKernel(s);
@@ -303,10 +299,8 @@ async function sendRegion({ keepGizmo = false, inStroke = false } = {}) {
   const steps = { started, lists: performance.now() };
   const posted = post('region', { support: compactIds(support), handles: handles.map(compactIds), k: state.k,
                                   ...methodRequest(state.method) });
-  // While the request travels and the server solves: the normal plan of the region sent (its
-  // movable vertices are the support, handles included, sorted).
+  // The region's movable vertices are the support, handles included, sorted.
   state.sentMovable = support;
-  view.setMovable(state.sentMovable);
   steps.planned = performance.now();
   const outcome = (async () => {
     try {
@@ -334,7 +328,6 @@ async function sendRegion({ keepGizmo = false, inStroke = false } = {}) {
 async function regionArrived({ failed, s, keepGizmo }) {
   if (failed || s.error) {
     state.sentMovable = null;
-    view.setMovable(state.movable);
     if (s) {
       state.status = s;
       panels.showStats(s, state.frameMs);

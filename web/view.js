@@ -76,6 +76,7 @@ const edgeMaterial = new THREE.MeshBasicMaterial({ color: 0x30343c, wireframe: t
 export const shown = { mesh: null, edges: null, baseLines: null, baseSurface: null };
 let plan = null; // normalPlan() of the current movable vertices (display ids)
 let planInWasm = null; // its normals in kernel.wasm (wasmNormals()), when the page has it
+let planned = { movable: null, done: true }; // the movable vertices of setMovable(), planned or not
 let around = null; // vertexFaces() of the drawn mesh
 // The mesh as drawn: splitCreases() of it, or null when the display is the mesh itself; the mesh's
 // positions (held, not copied); the display copies of the movable vertices.
@@ -142,6 +143,7 @@ export function setMesh(positions, indices) {
   scene.add(shown.edges);
   plan = null;
   planInWasm = null;
+  planned = { movable: null, done: true };
   around = vertexFaces(geometry.getIndex().array, n);
   redraw();
 }
@@ -165,20 +167,32 @@ export function positionsChanged() {
   touch(g.getAttribute('normal'));
 }
 
-/// Prepares applyMoved() for a region's movable vertices (once per region).
+/// Prepares applyMoved() for a region's movable vertices (once per region). The work (tens of
+/// milliseconds for a large support) is done after the next frame is drawn, when nothing waits
+/// for it (the manipulator shows first, and a server solving a region keeps both cores), or at
+/// the first applyMoved() before that.
 export function setMovable(movable) {
-  const g = shown.mesh.geometry;
+  const mine = { movable, done: false };
+  planned = mine;
+  requestAnimationFrame(() => setTimeout(() => { if (planned === mine) makePlan(); }, 0));
+}
+
+function makePlan() {
+  if (planned.done) return;
+  planned.done = true;
+  const g = shown.mesh.geometry, movable = planned.movable;
   const ids = movable && display ? withCopies(movable, display.copies) : movable;
   plan = ids ? normalPlan(g.getIndex().array, around, ids) : null;
   movedCopies = ids && display ? ids.slice(movable.length) : [];
   planInWasm = plan ? wasmNormals(g.getIndex().array, plan, movable, display?.map ?? null, meshPositions.length / 3) : null;
 }
 
-export const normalsEngine = () => (planInWasm ? 'wasm' : 'js');
+export const normalsEngine = () => { makePlan(); return planInWasm ? 'wasm' : 'js'; };
 
 /// A drag's frame: moved holds x, y, z for each of movable (setMovable's ids, in that order).
 /// Recomputes the normals that can change and uploads only the range that holds them.
 export function applyMoved(movable, moved) {
+  makePlan();
   const g = shown.mesh.geometry;
   const position = g.getAttribute('position'), normal = g.getAttribute('normal');
   const p = position.array;

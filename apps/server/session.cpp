@@ -80,6 +80,15 @@ std::pair<double, double> preprocess_share(std::string_view phase) {
   return {0.97, 1.0};
 }
 
+/// The steps of the last set_region that ran (docs/editing.md), in milliseconds.
+nlohmann::json set_region_parts(const EditReport& r) {
+  nlohmann::json parts = nlohmann::json::object();
+  for (const char* step : {"assemble", "factor", "solve", "encode", "nonlinear setup"})
+    if (const auto it = r.milliseconds.find(step); it != r.milliseconds.end())
+      parts[step] = it->second;
+  return parts;
+}
+
 } // namespace
 
 struct Session::Impl {
@@ -524,6 +533,7 @@ nlohmann::json Session::status() const {
                    {"free_base_vertices", r.free_base_vertices},
                    {"set_region_ms",
                     r.milliseconds.count("set_region") ? r.milliseconds.at("set_region") : 0.0},
+                   {"set_region_parts_ms", set_region_parts(r)},
                    {"movable", m.box->editor.movable_vertices().size()},
                    {"coarse_support", r.coarse_support}};
     nlohmann::json transforms = nlohmann::json::array();

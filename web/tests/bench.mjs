@@ -6,8 +6,8 @@
 //                        drawn; paint_pick_round_trip_ms: the pick request's part of it);
 //   mouseup_to_gizmo_ms  the handle stroke's mouse-up to the manipulator on the solved region,
 //                        nothing drawn;
-//                        set_region_ms, the server's part of it, and the rest,
-//                        mouseup_to_gizmo_beyond_set_region_ms;
+//                        set_region_ms, the server's part of it (set_region_parts_ms: its steps),
+//                        and the rest, mouseup_to_gizmo_beyond_set_region_ms;
 //   drag_cycle_ms        one manipulator move to its positions and normals applied, nothing drawn;
 //                        drag_cycle_shown_ms, drawn; of the hidden cycle: drag_server_ms, the server's
 //                        frame (X-Frame-Ms), drag_round_trip_ms, the request's send to its answer
@@ -100,6 +100,7 @@ try {
   const regionStatus = (await json('status')).region ?? {};
   const support = regionStatus.support ?? 0;
   const setRegion = regionStatus.set_region_ms ?? null;
+  const setRegionParts = regionStatus.set_region_parts_ms ?? null;
 
   // Drags of the manipulator's arrow, the mesh shown, then hidden.
   const dragCycle = async () => {
@@ -140,6 +141,7 @@ try {
     ready_ms: round(paintableAt - started), paint_move_ms: round(median(paintMove)),
     paint_move_shown_ms: round(median(paintMoveShown)), paint_pick_round_trip_ms: round(median(paintTrips)),
     mouseup_to_gizmo_ms: round(mouseupToGizmo), set_region_ms: round(setRegion),
+    set_region_parts_ms: setRegionParts && Object.fromEntries(Object.entries(setRegionParts).map(([k, v]) => [k, round(v)])),
     mouseup_to_gizmo_beyond_set_region_ms: round(setRegion === null ? null : mouseupToGizmo - setRegion),
     drag_cycle_ms: round(median(hidden.ms)), drag_server_ms: round(median(hidden.server)),
     drag_round_trip_ms: round(median(hidden.trip)), drag_apply_ms: round(median(hidden.apply)),
