@@ -54,6 +54,24 @@ TEST(Memory, KeepFreedMemoryServesLargeBlocksFromTheHeap) {
 #endif
 }
 
+TEST(Memory, KeepFreedMemoryServesAnotherThreadsLargeBlocksFromTheHeap) {
+#if !defined(__GLIBC__) || defined(REMORA_TEST_ASAN)
+  GTEST_SKIP() << "glibc's allocator only (the sanitizers bring their own)";
+#else
+  ASSERT_TRUE(keep_freed_memory());
+  // A thread of its own arena grows it in mappings of at most 64 MiB: a 64 MiB block would be a
+  // fresh mapping, counted in hblkhd, whatever the thresholds.
+  const std::size_t mapped_before = mallinfo2().hblkhd;
+  std::size_t mapped_during = 0;
+  std::thread([&] {
+    std::vector<char> big(std::size_t{64} << 20, 1);
+    mapped_during = mallinfo2().hblkhd;
+  }).join();
+  EXPECT_EQ(mapped_during, mapped_before)
+      << "the thread's block was mapped, not taken from the heap";
+#endif
+}
+
 TEST(Timer, MsSinceIsTheElapsedSteadyTimeInMilliseconds) {
   const Clock::time_point t0 = Clock::now();
   EXPECT_GE(ms_since(t0), 0.0);

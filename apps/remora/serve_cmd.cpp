@@ -6,10 +6,6 @@
 #include <iostream>
 #include <sstream>
 
-#ifdef __GLIBC__
-#include <malloc.h>
-#endif
-
 #include <fmt/format.h>
 
 #include "api.h"
@@ -75,12 +71,6 @@ void add_serve_command(CLI::App& app) {
           "the page's files are not in {0} (index.html missing): build them with `make build` "
           "(into the build folder's web/) or `scripts/build_web.sh {0}`, or give --web-root",
           a->web_root));
-#ifdef __GLIBC__
-    // One malloc arena for all threads: each job of the session runs on a thread of its own, and
-    // with glibc's arena per thread its memory came from pages never touched before, whose
-    // faults made a region's set_region two to three times slower (docs/server.md).
-    mallopt(M_ARENA_MAX, 1);
-#endif
     server::SessionOptions options;
     options.threads = a->threads;
     options.max_editors = static_cast<std::size_t>(a->history_editors);

@@ -18,8 +18,11 @@ std::uint64_t physical_memory_bytes() {
 bool keep_freed_memory() {
 #if defined(__GLIBC__)
   constexpr int kGiB = 1 << 30;
-  // Allocations below 1 GiB come from the heap; the heap's top is returned only above 1 GiB free.
-  return mallopt(M_MMAP_THRESHOLD, kGiB) == 1 && mallopt(M_TRIM_THRESHOLD, kGiB) == 1;
+  // Allocations below 1 GiB come from the heap; the heap's top is returned only above 1 GiB free;
+  // every thread allocates from that one heap (a thread's own arena grows in mappings of at most
+  // 64 MiB, so a thread's large blocks were fresh mappings whatever the thresholds).
+  return mallopt(M_MMAP_THRESHOLD, kGiB) == 1 && mallopt(M_TRIM_THRESHOLD, kGiB) == 1 &&
+         mallopt(M_ARENA_MAX, 1) == 1;
 #else
   return false;
 #endif

@@ -8,11 +8,13 @@ namespace remora {
 /// The machine's physical memory in bytes (sysconf), 0 where it cannot be told.
 std::uint64_t physical_memory_bytes();
 
-/// Asks the C library to serve large allocations from its heap instead of fresh mappings, and
-/// not to hand freed memory back to the system before exit. A remesh of a million triangles
-/// allocates and frees hundreds of megabytes per phase (a compaction copies the whole mesh);
-/// with fresh mappings every page is faulted in again each time (docs/benchmarks.md has the
-/// cost). The price: the process keeps its peak heap until it exits. Called once at the start of `remora` and of the benchmarks; a
+/// Asks the C library to serve large allocations from its heap instead of fresh mappings, from
+/// every thread (one arena), and not to hand freed memory back to the system before exit. A
+/// remesh of a million triangles allocates and frees hundreds of megabytes per phase (a
+/// compaction copies the whole mesh), and `remora serve` runs each job on a thread of its own;
+/// with fresh mappings every page is faulted in again each time (docs/benchmarks.md and
+/// docs/server.md have the cost). The price: the process keeps its peak heap until it exits.
+/// Called once at the start of `remora` and of the benchmarks, before any thread allocates; a
 /// no-op where the C library is not glibc. Returns whether the settings took effect.
 bool keep_freed_memory();
 
