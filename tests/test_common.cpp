@@ -2,6 +2,7 @@
 #include <atomic>
 #include <chrono>
 #include <cstddef>
+#include <stdexcept>
 #include <thread>
 #include <vector>
 
@@ -28,6 +29,29 @@ TEST(ParallelFor, VisitsEveryIndexOnceWhateverTheThreadCount) {
         ASSERT_EQ(visits[i].load(), 1) << "n = " << n << ", threads = " << threads << ", i = " << i;
     }
   }
+}
+
+TEST(ParallelFor, WithSerialOpenMpRunsTheRegionsItOpensOnOneThread) {
+  if (omp_get_max_threads() < 2 || omp_get_max_active_levels() > 1)
+    GTEST_SKIP() << "needs two threads and libgomp's default of one active level";
+  int outside = 0, inside = 0;
+#pragma omp parallel num_threads(4)
+  {
+#pragma omp master
+    outside = omp_get_num_threads();
+  }
+  with_serial_openmp([&] {
+#pragma omp parallel num_threads(4)
+    {
+#pragma omp master
+      inside = omp_get_num_threads();
+    }
+  });
+  EXPECT_GT(outside, 1);
+  EXPECT_EQ(inside, 1);
+  // What the body throws comes out of it.
+  EXPECT_THROW(with_serial_openmp([] { throw std::runtime_error("from the body"); }),
+               std::runtime_error);
 }
 
 // GCC defines __SANITIZE_ADDRESS__ under AddressSanitizer; clang 14 only answers __has_feature.

@@ -123,6 +123,13 @@ TEST(Server, EditRoundTripWithUndoAndRedo) {
   const json ready = json::parse(call(s, "GET", "/api/status").body);
   ASSERT_FALSE(ready.contains("error")) << ready;
   EXPECT_EQ(ready["region"]["support"], support.size());
+  // set_region's steps, each within the whole.
+  double steps = 0.0;
+  for (const char* step : {"assemble", "factor", "solve", "encode"}) {
+    ASSERT_TRUE(ready["region"]["set_region_parts_ms"].contains(step)) << ready["region"];
+    steps += ready["region"]["set_region_parts_ms"][step].get<double>();
+  }
+  EXPECT_LE(steps, ready["region"]["set_region_ms"].get<double>());
   const auto movable = as<std::uint32_t>(call(s, "GET", "/api/movable"));
   EXPECT_EQ(movable.size(), support.size());
   EXPECT_EQ(json::parse(call(s, "GET", "/api/region").body)["handles"][0].size(), handle.size());
