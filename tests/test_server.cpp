@@ -29,7 +29,9 @@ using nlohmann::json;
 using testing_server::as;
 using testing_server::call;
 using testing_server::expect_error;
+using testing_server::load_sphere_with_region;
 using testing_server::sphere_off;
+using testing_server::SphereRegion;
 
 TEST(Server, EmptySessionAnswersStatusAndRefusesTheRest) {
   Session s;
@@ -123,13 +125,6 @@ TEST(Server, EditRoundTripWithUndoAndRedo) {
   const json ready = json::parse(call(s, "GET", "/api/status").body);
   ASSERT_FALSE(ready.contains("error")) << ready;
   EXPECT_EQ(ready["region"]["support"], support.size());
-  // set_region's steps, each within the whole.
-  double steps = 0.0;
-  for (const char* step : {"assemble", "factor", "solve", "encode"}) {
-    ASSERT_TRUE(ready["region"]["set_region_parts_ms"].contains(step)) << ready["region"];
-    steps += ready["region"]["set_region_parts_ms"][step].get<double>();
-  }
-  EXPECT_LE(steps, ready["region"]["set_region_ms"].get<double>());
   const auto movable = as<std::uint32_t>(call(s, "GET", "/api/movable"));
   EXPECT_EQ(movable.size(), support.size());
   EXPECT_EQ(json::parse(call(s, "GET", "/api/region").body)["handles"][0].size(), handle.size());
@@ -213,9 +208,7 @@ TEST(Server, EditRoundTripWithUndoAndRedo) {
   EXPECT_NEAR(baked_rise, 0.5, 0.02);
 }
 
-// The export is the mesh I/O layer's memory writer on the current result, byte for byte, and
-// needs no file: it works without a usable temporary folder.
-/// `ids` as ranges of consecutive ids: [[first, count], ...].
+/// `ids` as ranges of consecutive ids: {"ranges": [[first, count], ...]}.
 json as_ranges(const std::vector<int>& ids) {
   json ranges = json::array();
   for (std::size_t i = 0; i < ids.size();) {
@@ -229,50 +222,95 @@ json as_ranges(const std::vector<int>& ids) {
 
 TEST(Server, ARegionSentAsRangesIsTheRegionOfTheIdsTheyList) {
   Session s;
-  ASSERT_EQ(call(s, "POST", "/api/load", sphere_off(), {{"name", "sphere.off"}}).status, 202);
-  s.wait();
-  const auto rest = as<float>(call(s, "GET", "/api/mesh/positions"));
-  std::vector<int> support, handle;
-  for (std::size_t v = 0; v < rest.size() / 3; ++v) {
-    if (rest[3 * v + 2] > 0.2) support.push_back(static_cast<int>(v));
-    if (rest[3 * v + 2] > 0.9) handle.push_back(static_cast<int>(v));
-  }
-  const json ranges = as_ranges(support);
+  // Ranges need a mesh to bound them.
+  expect_error(
+      call(s, "POST", "/api/region", R"({"support": {"ranges": [[0, 9]]}, "handles": [[0]]})"), 409,
+      "no mesh");
+  const SphereRegion sphere = load_sphere_with_region(s);
+  const json ranges = as_ranges(sphere.support), handle_ranges = as_ranges(sphere.handle);
   ASSERT_GT(ranges["ranges"].size(), 1u); // several ranges, some longer than one id
-  ASSERT_LT(ranges["ranges"].size(), support.size());
-  // The support as ranges, the handle as ids: the server lists the same ids back.
-  ASSERT_EQ(call(s, "POST", "/api/region", json{{"support", ranges}, {"handles", {handle}}}.dump())
-                .status,
-            202);
-  s.wait();
-  const json status = json::parse(call(s, "GET", "/api/status").body);
-  ASSERT_FALSE(status.contains("error")) << status;
-  const json region = json::parse(call(s, "GET", "/api/region").body);
-  EXPECT_EQ(region["support"].get<std::vector<int>>(), support);
-  EXPECT_EQ(region["handles"][0].get<std::vector<int>>(), handle);
-  // Bad ranges are 400s that name the range; the region stays.
-  const auto refused = [&](const std::string& support_json, const std::string& part,
-                           const ApiLimits& limits = {}) {
-    const std::string body = R"({"support": )" + support_json + R"(, "handles": [[0]]})";
-    const HttpResponse r = handle_api(s, HttpRequest{"POST", "/api/region", {}, body}, limits);
-    expect_error(r, 400, part);
+  ASSERT_LT(ranges["ranges"].size(), sphere.support.size());
+  // The support as ranges, the handle as ids, then both as ranges: the server lists the same ids.
+  for (const json& handle : {json(sphere.handle), handle_ranges}) {
+    ASSERT_EQ(
+        call(s, "POST", "/api/region", json{{"support", ranges}, {"handles", {handle}}}.dump())
+            .status,
+        202);
+    s.wait();
+    const json status = json::parse(call(s, "GET", "/api/status").body);
+    ASSERT_FALSE(status.contains("error")) << status;
+    const json region = json::parse(call(s, "GET", "/api/region").body);
+    EXPECT_EQ(region["support"].get<std::vector<int>>(), sphere.support);
+    EXPECT_EQ(region["handles"][0].get<std::vector<int>>(), sphere.handle);
+  }
+  // Bad ranges are 400s that name the list or the range; the region stays.
+  const auto refused = [&](const std::string& support_json, const std::string& handle_json,
+                           const std::string& part, const ApiLimits& limits = {}) {
+    const std::string body =
+        R"({"support": )" + support_json + R"(, "handles": [)" + handle_json + "]}";
+    expect_error(handle_api(s, HttpRequest{"POST", "/api/region", {}, body}, limits), 400, part);
   };
-  refused(R"({"ranges": [[0, 0]]})", "support.ranges[0]");
-  refused(R"({"ranges": [[1, 2], [-1, 2]]})", "support.ranges[1]");
-  refused(R"({"ranges": [[0]]})", "support.ranges[0]");
-  refused(R"({"ranges": [[2147483647, 2]]})", "support.ranges[0]");
-  refused(R"({"ranges": [[0, 1.5]]})", "support.ranges[0]");
-  refused(R"({"ranges": [[0, 2]], "more": 1})", "support: expected");
-  refused(R"({"ids": [1]})", "support: expected");
-  refused(R"({"ranges": [[0, 1000000000]]})", "more ids than the request can carry");
+  refused(R"({"ranges": [[0, 0]]})", "[0]", "support.ranges[0]");
+  refused(R"({"ranges": [[1, 2], [-1, 2]]})", "[0]", "support.ranges[1]");
+  refused(R"({"ranges": [[0]]})", "[0]", "support.ranges[0]");
+  refused(R"({"ranges": [[2147483647, 2]]})", "[0]", "support.ranges[0]");
+  refused(R"({"ranges": [[0, 1.5]]})", "[0]", "support.ranges[0]");
+  refused(R"({"ranges": [[0, 2]], "more": 1})", "[0]", "support: expected");
+  refused(R"({"ids": [1]})", "[0]", "support: expected");
+  // At most the mesh's vertex count per list, before anything is expanded.
+  refused(R"({"ranges": [[0, 1000000000]]})", "[0]",
+          "support: the ranges list more ids than the "
+          "mesh has vertices (642)");
+  refused(R"({"ranges": [[0, 600], [0, 43]]})", "[0]", "than the mesh has vertices (642)");
+  refused("[0]", R"({"ranges": [[0, 643]]})", "handles[0]: the ranges list more ids than the mesh");
+  // At most what the request's JSON limit could carry, over all its lists.
   ApiLimits small;
-  small.max_json_bytes = 200; // at most 100 ids over the request
-  refused(R"({"ranges": [[0, 60], [100, 60]]})", "support.ranges[1]", small);
-  refused(R"({"ranges": [[0, 700]]})", "more ids", {}); // within the budget: the session's bound
+  small.max_json_bytes = 200; // 100 ids
+  refused(R"({"ranges": [[0, 60], [100, 60]]})", "[0]",
+          "support: the ranges list more ids than a "
+          "request can carry (100)",
+          small);
+  refused("[1,2,3,4,5,6,7,8,9,10]", R"({"ranges": [[0, 95]]})",
+          "handles[0]: the ranges list more ids than a request can carry (90)", small);
+  // A range's last id within int: the session's check of the ids.
+  refused(R"({"ranges": [[2147483647, 1]]})", "[0]", "out of range");
   EXPECT_EQ(json::parse(call(s, "GET", "/api/region").body)["support"].get<std::vector<int>>(),
-            support);
+            sphere.support);
 }
 
+// The status gives set_region's steps, each within the whole; a region taken again from the
+// recent ones (no work) gives none, and a linear region after a nonlinear one no nonlinear step.
+TEST(Server, TheStatusGivesSetRegionsStepsOfTheRegionSet) {
+  Session s;
+  const SphereRegion sphere = load_sphere_with_region(s);
+  const auto parts = [&] { return json::parse(call(s, "GET", "/api/status").body)["region"]; };
+  const json first = parts();
+  double steps = 0.0;
+  for (const char* step : {"assemble", "factor", "solve", "encode"}) {
+    ASSERT_TRUE(first["set_region_parts_ms"].contains(step)) << first;
+    steps += first["set_region_parts_ms"][step].get<double>();
+  }
+  EXPECT_LE(steps, first["set_region_ms"].get<double>());
+  const auto region = [&](const std::vector<int>& support, const char* method) {
+    ASSERT_EQ(
+        call(s, "POST", "/api/region",
+             json{{"support", support}, {"handles", {sphere.handle}}, {"method", method}}.dump())
+            .status,
+        202);
+    s.wait();
+  };
+  std::vector<int> smaller(sphere.support.begin() + 1, sphere.support.end());
+  region(smaller, "nonlinear");
+  EXPECT_TRUE(parts()["set_region_parts_ms"].contains("nonlinear setup")) << parts();
+  std::vector<int> smallest(sphere.support.begin() + 2, sphere.support.end());
+  region(smallest, "linear");
+  EXPECT_FALSE(parts()["set_region_parts_ms"].contains("nonlinear setup")) << parts();
+  region(sphere.support, "linear"); // the first region, kept for an undo: taken again
+  EXPECT_TRUE(parts()["set_region_parts_ms"].empty()) << parts();
+}
+
+// The export is the mesh I/O layer's memory writer on the current result, byte for byte, and
+// needs no file: it works without a usable temporary folder.
 TEST(Server, ExportIsTheMemoryWriterAndNeedsNoTemporaryFolder) {
   Session s;
   const std::string off = sphere_off();

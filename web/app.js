@@ -301,7 +301,7 @@ async function sendRegion({ keepGizmo = false, inStroke = false } = {}) {
                                   ...methodRequest(state.method) });
   // The region's movable vertices are the support, handles included, sorted.
   state.sentMovable = support;
-  steps.planned = performance.now();
+  steps.requested = performance.now();
   const outcome = (async () => {
     try {
       panels.showProgress(await (await posted).json());

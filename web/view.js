@@ -179,12 +179,17 @@ export function setMovable(movable) {
 
 function makePlan() {
   if (planned.done) return;
-  planned.done = true;
+  // Nothing of the previous region's plan stays should this one fail.
+  plan = null;
+  planInWasm = null;
+  movedCopies = [];
   const g = shown.mesh.geometry, movable = planned.movable;
   const ids = movable && display ? withCopies(movable, display.copies) : movable;
-  plan = ids ? normalPlan(g.getIndex().array, around, ids) : null;
+  const made = ids ? normalPlan(g.getIndex().array, around, ids) : null;
   movedCopies = ids && display ? ids.slice(movable.length) : [];
-  planInWasm = plan ? wasmNormals(g.getIndex().array, plan, movable, display?.map ?? null, meshPositions.length / 3) : null;
+  planInWasm = made ? wasmNormals(g.getIndex().array, made, movable, display?.map ?? null, meshPositions.length / 3) : null;
+  plan = made;
+  planned.done = true;
 }
 
 export const normalsEngine = () => { makePlan(); return planInWasm ? 'wasm' : 'js'; };

@@ -73,17 +73,21 @@ json parse_json(const HttpRequest& request, const ApiLimits& limits) {
 }
 
 /// A list of vertex ids: an array of ids, or {"ranges": [[first, count], ...]} for the ids first,
-/// first + 1, ..., first + count - 1 of each range in turn. `budget` bounds the ids that ranges may
-/// expand to over the whole request (what arrays in a body of the same size could hold) and is
-/// decreased by each list read.
-std::vector<int> ids(const json& j, const std::string& path, std::size_t& budget) {
+/// first + 1, ..., first + count - 1 of each range in turn. Ranges expand to at most `vertices`
+/// ids per list (the mesh's vertex count: more can only repeat ids) and `budget` ids over the
+/// whole request (what arrays in a body of the JSON limit's size could hold), which each list
+/// read decreases.
+std::vector<int> ids(const json& j, const std::string& path, std::size_t vertices,
+                     std::size_t& budget) {
   constexpr long long kMaxId = 2147483647LL;
   std::vector<int> out;
   if (j.is_object()) {
     if (j.size() != 1 || !j.contains("ranges") || !j.at("ranges").is_array())
       throw BadRequest(path + ": expected an array of vertex ids or {\"ranges\": [[first, count], "
                               "...]}");
+    if (vertices == 0) throw Busy("no mesh is loaded yet: load one first");
     const json& ranges = j.at("ranges");
+    std::size_t total = 0;
     for (std::size_t i = 0; i < ranges.size(); ++i) {
       const json& r = ranges[i];
       const auto integer = [](const json& x) { return x.is_number_integer(); };
@@ -93,14 +97,21 @@ std::vector<int> ids(const json& j, const std::string& path, std::size_t& budget
         throw BadRequest(fmt::format("{}.ranges[{}]: expected [first, count], first >= 0, count "
                                      ">= 1, first + count - 1 a vertex id",
                                      path, i));
-      const auto first = r[0].get<long long>(), count = r[1].get<long long>();
-      if (static_cast<unsigned long long>(count) > budget)
-        throw BadRequest(fmt::format("{}.ranges[{}]: the ranges list more ids than the request "
-                                     "can carry",
-                                     path, i));
-      budget -= static_cast<std::size_t>(count);
-      for (long long v = first; v < first + count; ++v) out.push_back(static_cast<int>(v));
+      total += static_cast<std::size_t>(r[1].get<long long>());
+      if (total > vertices)
+        throw BadRequest(fmt::format("{}: the ranges list more ids than the mesh has vertices "
+                                     "({})",
+                                     path, vertices));
+      if (total > budget)
+        throw BadRequest(fmt::format("{}: the ranges list more ids than a request can carry ({})",
+                                     path, budget));
     }
+    out.reserve(total);
+    for (const json& r : ranges)
+      for (long long v = r[0].get<long long>(); v < r[0].get<long long>() + r[1].get<long long>();
+           ++v)
+        out.push_back(static_cast<int>(v));
+    budget -= total;
     return out;
   }
   if (!j.is_array())
@@ -132,12 +143,13 @@ HttpResponse region(Session& session, const HttpRequest& request, const ApiLimit
     throw BadRequest("expected {\"support\": [ids], \"handles\": [[ids], ...], \"k\": 1|2|3, "
                      "\"method\": \"linear\"|\"nonlinear\", \"energy\": name}");
   std::size_t budget = limits.max_json_bytes / 2; // "0," per id in an array
-  std::vector<int> support = ids(j.at("support"), "support", budget);
+  const std::size_t vertices = session.vertex_count();
+  std::vector<int> support = ids(j.at("support"), "support", vertices, budget);
   const json& hs = j.at("handles");
   if (!hs.is_array()) throw BadRequest("handles: expected an array of lists of vertex ids");
   std::vector<std::vector<int>> handles;
   for (std::size_t i = 0; i < hs.size(); ++i)
-    handles.push_back(ids(hs[i], fmt::format("handles[{}]", i), budget));
+    handles.push_back(ids(hs[i], fmt::format("handles[{}]", i), vertices, budget));
   int k = 2;
   if (j.contains("k")) {
     if (!j.at("k").is_number_integer()) throw BadRequest("k: expected 1, 2 or 3");

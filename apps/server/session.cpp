@@ -80,9 +80,11 @@ std::pair<double, double> preprocess_share(std::string_view phase) {
   return {0.97, 1.0};
 }
 
-/// The steps of the last set_region that ran (docs/editing.md), in milliseconds.
+/// The steps of the last set_region (docs/editing.md), in milliseconds; none when it took a
+/// region kept for an undo (no step ran).
 nlohmann::json set_region_parts(const EditReport& r) {
   nlohmann::json parts = nlohmann::json::object();
+  if (r.region_reused) return parts;
   for (const char* step : {"assemble", "factor", "solve", "encode", "nonlinear setup"})
     if (const auto it = r.milliseconds.find(step); it != r.milliseconds.end())
       parts[step] = it->second;
@@ -361,6 +363,11 @@ Session::~Session() {
 void Session::wait() {
   std::unique_lock lock(impl_->mutex);
   impl_->idle.wait(lock, [&] { return !impl_->busy; });
+}
+
+std::size_t Session::vertex_count() const {
+  std::lock_guard lock(impl_->mutex);
+  return impl_->box ? impl_->box->editor.input().n_vertices() : 0;
 }
 
 void Session::wait_for(std::chrono::milliseconds timeout) {

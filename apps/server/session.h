@@ -86,6 +86,9 @@ public:
   void start_region(std::vector<int> support, std::vector<std::vector<int>> handles, int k,
                     EditMethod method = EditMethod::Linear,
                     std::optional<NonlinearEnergy> energy = std::nullopt);
+  /// The vertex count of the mesh loaded (0 before the first load): no list of a region can
+  /// hold more ids without repeating one.
+  std::size_t vertex_count() const;
   /// Blocks until the worker is idle (tests and the CLI).
   void wait();
   /// Blocks until the worker is idle or `timeout` has passed (a client's long poll of the

@@ -20,7 +20,7 @@ bool keep_freed_memory() {
   constexpr int kGiB = 1 << 30;
   // Allocations below 1 GiB come from the heap; the heap's top is returned only above 1 GiB free;
   // every thread allocates from that one heap (a thread's own arena grows in mappings of at most
-  // 64 MiB, so a thread's large blocks were fresh mappings whatever the thresholds).
+  // 64 MiB, so a thread's large blocks are fresh mappings whatever the thresholds).
   return mallopt(M_MMAP_THRESHOLD, kGiB) == 1 && mallopt(M_TRIM_THRESHOLD, kGiB) == 1 &&
          mallopt(M_ARENA_MAX, 1) == 1;
 #else

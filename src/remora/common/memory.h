@@ -14,8 +14,10 @@ std::uint64_t physical_memory_bytes();
 /// compaction copies the whole mesh), and `remora serve` runs each job on a thread of its own;
 /// with fresh mappings every page is faulted in again each time (docs/benchmarks.md and
 /// docs/server.md have the cost). The price: the process keeps its peak heap until it exits.
-/// Called once at the start of `remora` and of the benchmarks, before any thread allocates; a
-/// no-op where the C library is not glibc. Returns whether the settings took effect.
+/// Called once at the start of `remora` and of the benchmarks, before any thread allocates
+/// (glibc hands a new thread an arena left by a thread that ended before it counts arenas). The
+/// settings hold for the whole process, a host program's own threads included. A no-op where
+/// the C library is not glibc. Returns whether the settings took effect.
 bool keep_freed_memory();
 
 } // namespace remora

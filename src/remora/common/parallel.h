@@ -33,13 +33,14 @@ void parallel_blocks(std::size_t n, int threads, Body&& body) {
 
 /// Runs body() so that the OpenMP parallel regions it opens run on one thread, for a library whose
 /// regions we cannot size: body() runs as the master of an active two-thread region, and libgomp
-/// runs the regions nested in it on one thread (its max-active-levels is 1 unless
-/// OMP_MAX_ACTIVE_LEVELS or OMP_NESTED raise it). The other thread waits at the region's end,
-/// asleep after a short spin. Inside an active region already, body() runs as it is. What
-/// body() throws is rethrown here.
+/// runs the regions nested in it on one thread while its max-active-levels is 1 (the default;
+/// OMP_MAX_ACTIVE_LEVELS, OMP_NESTED or a list in OMP_NUM_THREADS raise it, and then body() runs
+/// as it is, as it does inside an active region already). The other thread waits at the region's
+/// end, asleep after a short spin (all along with OMP_WAIT_POLICY=active). A BLAS built on
+/// OpenMP also runs on one thread inside. What body() throws is rethrown here.
 template <class Body>
 void with_serial_openmp(Body&& body) {
-  if (omp_get_active_level() > 0) {
+  if (omp_get_active_level() > 0 || omp_get_max_active_levels() > 1) {
     body();
     return;
   }

@@ -132,8 +132,12 @@ public:
     std::optional<BlasThreadsScope> one_blas_thread;
     if (small_) one_blas_thread.emplace();
     // CHOLMOD 3 opens an OpenMP region of 4 threads for small loops of every supernode (zeroing,
-    // scattering); their wake-ups doubled a mesh's factorization (docs/solvers.md).
-    with_serial_openmp([&] { llt_.factorize(a); });
+    // scattering); their wake-ups doubled a small factorization (docs/solvers.md). A large one
+    // keeps them, and its BLAS threads.
+    if (small_)
+      with_serial_openmp([&] { llt_.factorize(a); });
+    else
+      llt_.factorize(a);
     const cholmod_factor* l = llt_.factor();
     if (llt_.info() != Eigen::Success || l == nullptr || l->minor < l->n)
       throw NumericalError(not_spd("cholmod"));

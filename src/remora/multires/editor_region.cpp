@@ -383,6 +383,9 @@ Editor::Prepared Editor::prepare_region(const std::vector<int>& support,
   r.system = m.options.system;
   r.report = m.report;
   r.report.region_reused = false;
+  for (const char* step :
+       {"assemble", "factor", "solve", "encode", "nonlinear setup", "nonlinear coarse base"})
+    r.report.milliseconds.erase(step); // the last region's: this one's are measured below
   m.map_to_base(r);
   m.bytes_for(r);
   m.make_room(r.bytes);
