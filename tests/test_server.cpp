@@ -286,7 +286,7 @@ TEST(Server, TheStatusGivesSetRegionsStepsOfTheRegionSet) {
   const auto parts = [&] { return json::parse(call(s, "GET", "/api/status").body)["region"]; };
   const json first = parts();
   double steps = 0.0;
-  for (const char* step : {"assemble", "factor", "solve", "encode"}) {
+  for (const char* step : {"map", "assemble", "factor", "solve", "encode", "finish"}) {
     ASSERT_TRUE(first["set_region_parts_ms"].contains(step)) << first;
     steps += first["set_region_parts_ms"][step].get<double>();
   }

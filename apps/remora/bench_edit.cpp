@@ -105,7 +105,7 @@ void time_later_regions(Editor& editor, const BenchEditArgs& a, BenchEditTimes& 
           "capped at 90 % of the base's vertices); use a smaller --support or fewer --regions",
           r + 1));
     free_before = editor.report().free_base_vertices;
-    for (const char* part : {"assemble", "factor", "solve", "encode"})
+    for (const char* part : {"map", "assemble", "factor", "solve", "encode", "finish"})
       times[part].push_back(editor.report().milliseconds.at(part));
   }
   for (auto& [part, v] : times) {
@@ -143,17 +143,19 @@ void print_bench_edit(const BenchEditArgs& a, const EditReport& r, const BenchEd
                            r.milliseconds.at("base report"));
   std::cout << fmt::format(
       "set_region {:.0f} ms for {} free base vertices, {} handle base "
-      "vertices, k = {} (assemble {:.0f}, factor {:.0f}, solve {:.0f}, "
-      "encode {:.0f} of {} vertices) with {}\n",
+      "vertices, k = {} (map {:.0f}, assemble {:.0f}, factor {:.0f}, solve {:.0f}, "
+      "encode {:.0f} of {} vertices, finish {:.0f}) with {}\n",
       t.set_region_ms, grouped(r.free_base_vertices), grouped(r.handle_base_vertices.at(0)), a.k,
-      r.milliseconds.at("assemble"), r.milliseconds.at("factor"), r.milliseconds.at("solve"),
-      r.milliseconds.at("encode"), grouped(r.phong.encoded), r.solver);
+      r.milliseconds.at("map"), r.milliseconds.at("assemble"), r.milliseconds.at("factor"),
+      r.milliseconds.at("solve"), r.milliseconds.at("encode"), grouped(r.phong.encoded),
+      r.milliseconds.at("finish"), r.solver);
   if (!t.later_regions.empty())
-    std::cout << fmt::format("set_region, regions 2 to {} (each 1 % larger): median {:.0f} ms "
-                             "(assemble {:.0f}, factor {:.0f}, solve {:.0f}, encode {:.0f})\n",
-                             a.regions, t.later_regions.at("set_region"),
-                             t.later_regions.at("assemble"), t.later_regions.at("factor"),
-                             t.later_regions.at("solve"), t.later_regions.at("encode"));
+    std::cout << fmt::format(
+        "set_region, regions 2 to {} (each 1 % larger): median {:.0f} ms (map {:.0f}, assemble "
+        "{:.0f}, factor {:.0f}, solve {:.0f}, encode {:.0f}, finish {:.0f})\n",
+        a.regions, t.later_regions.at("set_region"), t.later_regions.at("map"),
+        t.later_regions.at("assemble"), t.later_regions.at("factor"), t.later_regions.at("solve"),
+        t.later_regions.at("encode"), t.later_regions.at("finish"));
   std::cout << fmt::format("frame (blend + decode): median {:.2f} ms, max {:.2f} ms over {} "
                            "frames (medians: blend {:.2f}, normals {:.2f}, decode {:.2f})\n",
                            median, t.frames.back(), t.frames.size(), t.frame_parts.at("blend"),

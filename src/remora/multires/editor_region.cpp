@@ -375,6 +375,7 @@ Editor::Prepared Editor::prepare_region(const std::vector<int>& support,
     r.report.milliseconds["set_region"] = ms_since(t_start);
     return prepared;
   }
+  const auto t_map = Clock::now();
   std::unique_ptr<RegionState> state = m.paint(support, handles);
   RegionState& r = *state;
   r.owner = impl_.get();
@@ -383,25 +384,30 @@ Editor::Prepared Editor::prepare_region(const std::vector<int>& support,
   r.system = m.options.system;
   r.report = m.report;
   r.report.region_reused = false;
-  for (const char* step :
-       {"assemble", "factor", "solve", "encode", "nonlinear setup", "nonlinear coarse base"})
+  for (const char* step : {"map", "assemble", "factor", "solve", "encode", "nonlinear setup",
+                           "nonlinear coarse base", "finish"})
     r.report.milliseconds.erase(step); // the last region's: this one's are measured below
   m.map_to_base(r);
   m.bytes_for(r);
   m.make_room(r.bytes);
   m.report_region(r, r.report);
+  r.report.milliseconds["map"] = ms_since(t_map);
   check();
   m.solve_basis(r, r.report, stop);
   check();
+  auto t_finish = Clock::now();
   m.find_affected(r);
+  double finish_ms = ms_since(t_finish);
   m.encode_details(r, r.report, stop);
   check();
   if (m.options.method == EditMethod::Nonlinear) m.build_nonlinear(r, r.report);
+  t_finish = Clock::now();
   r.transforms.assign(static_cast<std::size_t>(r.handles), identity_transform());
   r.frame = frame_rows(r.rest, r.rest_normals);
   r.rest_normals.resize(0, 0); // in the frame now
   r.current_positions = m.input_positions;
   r.dirty = true;
+  r.report.milliseconds["finish"] = finish_ms + ms_since(t_finish);
   r.report.milliseconds["set_region"] = ms_since(t_start);
   Prepared prepared;
   prepared.state_ = std::move(state);
