@@ -87,17 +87,19 @@ std::vector<int> ids(const json& j, const std::string& path, std::size_t vertice
                               "...]}");
     if (vertices == 0) throw Busy("no mesh is loaded yet: load one first");
     const json& ranges = j.at("ranges");
+    std::vector<std::pair<long long, long long>> runs; // first, count
     std::size_t total = 0;
     for (std::size_t i = 0; i < ranges.size(); ++i) {
       const json& r = ranges[i];
-      const auto integer = [](const json& x) { return x.is_number_integer(); };
-      if (!r.is_array() || r.size() != 2 || !integer(r[0]) || !integer(r[1]) ||
-          r[0].get<long long>() < 0 || r[1].get<long long>() < 1 ||
-          r[0].get<long long>() > kMaxId - r[1].get<long long>() + 1)
+      const bool well_formed =
+          r.is_array() && r.size() == 2 && r[0].is_number_integer() && r[1].is_number_integer();
+      const long long first = well_formed ? r[0].get<long long>() : -1;
+      const long long count = well_formed ? r[1].get<long long>() : 0;
+      if (first < 0 || count < 1 || first > kMaxId - count + 1)
         throw BadRequest(fmt::format("{}.ranges[{}]: expected [first, count], first >= 0, count "
                                      ">= 1, first + count - 1 a vertex id",
                                      path, i));
-      total += static_cast<std::size_t>(r[1].get<long long>());
+      total += static_cast<std::size_t>(count);
       if (total > vertices)
         throw BadRequest(fmt::format("{}: the ranges list more ids than the mesh has vertices "
                                      "({})",
@@ -105,12 +107,11 @@ std::vector<int> ids(const json& j, const std::string& path, std::size_t vertice
       if (total > budget)
         throw BadRequest(fmt::format("{}: the ranges list more ids than a request can carry ({})",
                                      path, budget));
+      runs.emplace_back(first, count);
     }
     out.reserve(total);
-    for (const json& r : ranges)
-      for (long long v = r[0].get<long long>(); v < r[0].get<long long>() + r[1].get<long long>();
-           ++v)
-        out.push_back(static_cast<int>(v));
+    for (const auto& [first, count] : runs)
+      for (long long v = first; v < first + count; ++v) out.push_back(static_cast<int>(v));
     budget -= total;
     return out;
   }

@@ -85,8 +85,7 @@ std::pair<double, double> preprocess_share(std::string_view phase) {
 nlohmann::json set_region_parts(const EditReport& r) {
   nlohmann::json parts = nlohmann::json::object();
   if (r.region_reused) return parts;
-  for (const char* step :
-       {"map", "assemble", "factor", "solve", "encode", "nonlinear setup", "finish"})
+  for (const char* step : kSetRegionSteps)
     if (const auto it = r.milliseconds.find(step); it != r.milliseconds.end())
       parts[step] = it->second;
   return parts;

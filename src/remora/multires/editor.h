@@ -100,6 +100,12 @@ struct EditorOptions {
 /// EditReport::coarse_support is set above this support_edge_ratio.
 inline constexpr double kCoarseSupportRatio = 4.0;
 
+/// The steps of set_region() that EditReport::milliseconds times (docs/editing.md), in order;
+/// the nonlinear ones only for method nonlinear.
+inline constexpr std::array<const char*, 8> kSetRegionSteps = {
+    "map",   "assemble", "factor", "solve", "encode", "nonlinear setup", "nonlinear coarse base",
+    "finish"};
+
 struct EditReport {
   std::size_t input_vertices = 0, input_faces = 0;
   std::size_t base_vertices = 0, base_faces = 0;

@@ -384,8 +384,7 @@ Editor::Prepared Editor::prepare_region(const std::vector<int>& support,
   r.system = m.options.system;
   r.report = m.report;
   r.report.region_reused = false;
-  for (const char* step : {"map", "assemble", "factor", "solve", "encode", "nonlinear setup",
-                           "nonlinear coarse base", "finish"})
+  for (const char* step : kSetRegionSteps)
     r.report.milliseconds.erase(step); // the last region's: this one's are measured below
   m.map_to_base(r);
   m.bytes_for(r);
