@@ -133,7 +133,7 @@ function loadKernel(s) {
   const regionId = s.region_id, movable = state.movable;
   Promise.all([fetch('api/region/kernel').then((r) => (r.ok ? r.arrayBuffer() : null)), engineLoaded]).then(([buffer]) => {
     if (!buffer || state.held.region !== regionId || state.movable !== movable) return;
-    const data = parseKernel(buffer);
+    const data = parseKernel(buffer, view.drawnNormals(movable));
     releaseKernel(kernel?.data);
     kernel = { regionId, data, out: new Float32Array(3 * movable.length) };
     state.marks.kernel.push({ at: performance.now(), bytes: buffer.byteLength });
@@ -151,7 +151,7 @@ function localFrame(t0) {
   evaluateKernel(kernel.data, transformRows(), kernel.out);
   const evaluated = performance.now();
   state.frameMs = evaluated - t0;
-  view.applyMoved(state.movable, kernel.out);
+  view.applyMoved(state.movable, kernel.out, kernel.data.wasm?.drawn ?? null);
   const done = performance.now();
   state.marks.drag.push(done - t0);
   state.marks.dragKernel.push(evaluated - t0);
@@ -630,6 +630,18 @@ window.remora = {
     let worst = 0;
     for (let i = 0; i < a.length; ++i) worst = Math.max(worst, Math.abs(a[i] - b[i]));
     return worst;
+  },
+  /// normalError() of the page's own frame under the live transforms, its drawn normals computed
+  /// as its last step (kernel.wasm on two threads); then the positions shown before come back.
+  /// Null when the region's kernel has no such step.
+  frameNormalError() {
+    if (!kernelUsable() || !kernel.data.wasm?.drawn) return null;
+    const shownBefore = new Float32Array(3 * state.movable.length);
+    state.movable.forEach((v, i) => { for (let c = 0; c < 3; ++c) shownBefore[3 * i + c] = state.positions[3 * v + c]; });
+    localFrame(performance.now());
+    const error = this.normalError();
+    view.applyMoved(state.movable, shownBefore);
+    return error;
   },
   /// Where a drag's normals are computed: 'wasm' (kernel.wasm) or 'js'.
   normalsEngine: () => view.normalsEngine(),

@@ -50,15 +50,16 @@ export function wasmLayout() {
 }
 
 /// One frame's steps on two threads: run(step) evaluates the page's part of a step of
-/// frame_part() (web/wasm/kernel.cpp) while the worker evaluates the other, and returns when both
+/// page_part() (web/wasm/kernel.cpp) while the worker evaluates the other, and returns when both
 /// are done; until the worker is ready, or without workers, the page evaluates the whole step.
-/// `control`: 16 bytes reserved in the instance's memory for the handshake (Int32: the step's
-/// number, the step, the number of the step the worker finished); `stackTop`: the end of an
-/// area reserved for the worker's stack (each instance has its own stack pointer, and the page's
-/// stack is the module's own, below __heap_base).
+/// `args`: page_part()'s pointers (the kernel, the transforms, the result, the drawn normals or
+/// 0); `control`: 16 bytes reserved in the instance's memory for the handshake (Int32: the
+/// step's number, the step, the number of the step the worker finished); `stackTop`: the end of
+/// an area reserved for the worker's stack (each instance has its own stack pointer, and the
+/// page's stack is the module's own, below __heap_base).
 export class FrameThreads {
-  constructor(instance, struct, transforms, out, control, stackTop) {
-    Object.assign(this, { exports: instance.exports, struct, transforms, out, ready: false, worker: null });
+  constructor(instance, args, control, stackTop) {
+    Object.assign(this, { exports: instance.exports, args, ready: false, worker: null });
     this.control = new Int32Array(instance.buffer, control, 4);
     if (typeof Worker === 'undefined' || (globalThis.navigator?.hardwareConcurrency ?? 1) < 2) return;
     try {
@@ -69,27 +70,27 @@ export class FrameThreads {
     }
     this.worker.onmessage = () => { this.ready = true; };
     this.worker.onerror = (e) => { console.warn(`frame worker: ${e.message}; one thread from now on`); this.stop(); };
-    this.worker.postMessage({ module: wasmModule, memory: instance.memory, struct, transforms, out, control, stackTop });
+    this.worker.postMessage({ module: wasmModule, memory: instance.memory, args, control, stackTop });
   }
   get threads() { return this.ready ? 2 : 1; }
   /// `single`: the page's thread alone (the benchmark compares).
   run(step, single = false) {
-    const { exports: w, struct, transforms, out, control: c } = this;
+    const { exports: w, args, control: c } = this;
     if (!this.ready || single) {
-      w.frame_part(struct, transforms, out, step, 0, 1);
+      w.page_part(...args, step, 0, 1);
       return;
     }
     Atomics.store(c, 1, step);
     const number = Atomics.add(c, 0, 1) + 1;
     Atomics.notify(c, 0);
-    w.frame_part(struct, transforms, out, step, 0, 2);
+    w.page_part(...args, step, 0, 2);
     // The worker's half takes as long as ours: wait for it here (the page's thread may not block).
     const start = performance.now();
     for (let spins = 1; Atomics.load(c, 2) !== number; ++spins) {
       if ((spins & 1023) === 0 && performance.now() - start > 1000) {
         console.warn('frame worker: no answer in 1 s; one thread from now on');
         this.stop();
-        w.frame_part(struct, transforms, out, step, 1, 2);
+        w.page_part(...args, step, 1, 2);
         return;
       }
     }

@@ -13,13 +13,17 @@
 // step the library's replay leaves to its caller (blended motions' step 1).
 
 import { FrameThreads, wasmLayout } from './engine.js';
+import { placeDrawnNormals } from './normals.js';
 
 const HEADER_WORDS = 16;
 const WORKER_STACK = 1 << 16; // the worker instance's stack, in the region's memory
 
 /// The kernel of a region from the bytes of `GET /api/region/kernel` (docs/server.md). Throws
-/// an Error for a buffer whose sections do not add up.
-export function parseKernel(buffer) {
+/// an Error for a buffer whose sections do not add up. `drawn`: the drawn normals around the
+/// region's movable vertices (web/normals.js, drawnNormalsLayout()), which its frames in
+/// kernel.wasm then compute as their last step (k.wasm.drawn: applyMoved()'s `fromFrame`,
+/// web/view.js), or null.
+export function parseKernel(buffer, drawn = null) {
   const header = new Uint32Array(buffer, 0, HEADER_WORDS);
   const [version, handles, local, rows, columns, handleVertices, faces, normalVertices, ringLength,
     records, residuals, hasOffsets, blended] = header;
@@ -66,7 +70,7 @@ export function parseKernel(buffer) {
     k.pivots.push(o);
   }
   const layout = wasmLayout();
-  if (layout) attachWasm(k, layout);
+  if (layout) attachWasm(k, layout, drawn);
   // The frame's working rows, a vertex's position and normal side by side (one cache line read per
   // corner), in double precision, at rest to begin with (rows that no frame writes keep them).
   else k.xn = Float64Array.from(k.rest);
@@ -89,8 +93,9 @@ function javascriptRows(k) {
 /// Copies the kernel's arrays into the memory of a new instance of kernel.wasm (web/engine.js; one
 /// per region: its memory goes with the kernel) and lays out struct FrameReplay (frame_replay.h:
 /// 24 words of 4 bytes) over them. k.xn becomes the instance's working rows, so that the
-/// JavaScript steps (blended motions) write where the WebAssembly ones read.
-function attachWasm(k, layout) {
+/// JavaScript steps (blended motions) write where the WebAssembly ones read. The drawn normals'
+/// positions begin with the frame's result (the moved vertices' slots are its slots).
+function attachWasm(k, layout, drawn) {
   const sections = [];
   const place = (array) => {
     if (!array) return 0; // a null pointer: no offsets
@@ -102,7 +107,10 @@ function attachWasm(k, layout) {
     'ring', 'recordFace', 'recordSlot', 'recordBary', 'recordOffset', 'recordResidual', 'residuals', 'offsets'];
   const pointers = names.map((name) => place(k[name]));
   const x = layout.reserve(8 * 6 * k.local), cross = layout.reserve(8 * 3 * k.ringFaces);
-  const transforms = layout.reserve(8 * 12 * k.handles), out = layout.reserve(4 * 3 * k.slots);
+  if (drawn && drawn.movable.length !== k.slots) drawn = null; // not the movable vertices of these records
+  const slots = drawn ? drawn.movable.length + drawn.constants.length : k.slots;
+  const transforms = layout.reserve(8 * 12 * k.handles), out = layout.reserve(4 * 3 * slots);
+  const placeDrawn = drawn ? placeDrawnNormals(layout, drawn, out) : null;
   const struct = layout.reserve(4 * 24), control = layout.reserve(16), stack = layout.reserve(WORKER_STACK);
   const instance = layout.instantiate(), memory = instance.buffer;
   // The JavaScript steps read the same copies: the region's data is held once.
@@ -112,8 +120,10 @@ function attachWasm(k, layout) {
     k.ringFaces, ...pointers, x, cross]);
   k.xn = new Float64Array(memory, x, 6 * k.local);
   k.xn.set(k.rest);
-  k.wasm = { threads: new FrameThreads(instance, struct, transforms, out, control, stack + WORKER_STACK),
-             maps: new Float64Array(memory, transforms, 12 * k.handles), result: new Float32Array(memory, out, 3 * k.slots) };
+  const placed = placeDrawn ? placeDrawn(memory) : null;
+  const threads = new FrameThreads(instance, [struct, transforms, out, placed?.struct ?? 0], control, stack + WORKER_STACK);
+  k.wasm = { threads, maps: new Float64Array(memory, transforms, 12 * k.handles), result: new Float32Array(memory, out, 3 * k.slots),
+             drawn: placed && { movable: placed.movable, update: (positions, normals) => placed.update(positions, normals, () => threads.run(4)) } };
 }
 
 /// Ends what a kernel holds beyond its arrays (the worker of its frames).

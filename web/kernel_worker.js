@@ -4,7 +4,7 @@
 const SPIN_MS = 100;
 
 onmessage = ({ data }) => {
-  const { module, memory, struct, transforms, out, control, stackTop } = data;
+  const { module, memory, args, control, stackTop } = data;
   const w = new WebAssembly.Instance(module, { env: { memory } }).exports;
   w.__stack_pointer.value = stackTop; // a stack of its own in the shared memory
   const c = new Int32Array(memory.buffer, control, 4);
@@ -21,7 +21,7 @@ onmessage = ({ data }) => {
     seen = Atomics.load(c, 0);
     const step = Atomics.load(c, 1);
     if (step < 0) return;
-    w.frame_part(struct, transforms, out, step, 1, 2);
+    w.page_part(...args, step, 1, 2);
     Atomics.store(c, 2, seen);
   }
 };

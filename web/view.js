@@ -4,8 +4,9 @@
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 import { TransformControls } from 'three/addons/controls/TransformControls.js';
-import { normalPlan, updateNormals, vertexFaces, wasmNormals } from './normals.js';
+import { drawnNormalsLayout, normalPlan, updateNormals, vertexFaces, wasmNormals } from './normals.js';
 import { splitCreases, withCopies } from './creases.js';
+import { engine } from './engine.js';
 
 export const FIXED = -2, FREE = -1;
 export const HANDLE_COLORS = [[0.90, 0.30, 0.25], [0.25, 0.55, 0.95], [0.30, 0.80, 0.40], [0.85, 0.45, 0.90],
@@ -75,6 +76,7 @@ const edgeMaterial = new THREE.MeshBasicMaterial({ color: 0x30343c, wireframe: t
 /// The drawn objects (null until there is something to draw).
 export const shown = { mesh: null, edges: null, baseLines: null, baseSurface: null };
 let plan = null; // normalPlan() of the current movable vertices (display ids)
+let planLayout = null; // its drawnNormalsLayout(), when the page has kernel.wasm
 let planInWasm = null; // its normals in kernel.wasm (wasmNormals()), when the page has it
 let planned = { movable: null, done: true }; // the movable vertices of setMovable(), planned or not
 let around = null; // vertexFaces() of the drawn mesh
@@ -142,6 +144,7 @@ export function setMesh(positions, indices) {
   scene.add(shown.mesh);
   scene.add(shown.edges);
   plan = null;
+  planLayout = null;
   planInWasm = null;
   planned = { movable: null, done: true };
   around = vertexFaces(geometry.getIndex().array, n);
@@ -181,22 +184,37 @@ function makePlan() {
   if (planned.done) return;
   // Nothing of the previous region's plan stays should this one fail.
   plan = null;
+  planLayout = null;
   planInWasm = null;
   movedCopies = [];
   const g = shown.mesh.geometry, movable = planned.movable;
   const ids = movable && display ? withCopies(movable, display.copies) : movable;
   const made = ids ? normalPlan(g.getIndex().array, around, ids) : null;
   movedCopies = ids && display ? ids.slice(movable.length) : [];
-  planInWasm = made ? wasmNormals(g.getIndex().array, made, movable, display?.map ?? null, meshPositions.length / 3) : null;
+  if (made && engine() === 'wasm') {
+    planLayout = drawnNormalsLayout(g.getIndex().array, g.getAttribute('position').array, made, movable, display?.map ?? null, meshPositions.length / 3);
+    planInWasm = wasmNormals(planLayout);
+  }
   plan = made;
   planned.done = true;
 }
 
 export const normalsEngine = () => { makePlan(); return planInWasm ? 'wasm' : 'js'; };
 
+/// The drawnNormalsLayout() of setMovable()'s `movable`, for a region's kernel that computes the
+/// drawn normals as a step of its frames (web/kernel.js); null without kernel.wasm or for other
+/// vertices.
+export function drawnNormals(movable) {
+  if (planned.movable !== movable) return null;
+  makePlan();
+  return planLayout;
+}
+
 /// A drag's frame: moved holds x, y, z for each of movable (setMovable's ids, in that order).
 /// Recomputes the normals that can change and uploads only the range that holds them.
-export function applyMoved(movable, moved) {
+/// `fromFrame`: the drawn normals of the kernel that computed `moved` ({ movable,
+/// update(positions, normals) }, web/kernel.js), or null (the normals are computed here).
+export function applyMoved(movable, moved, fromFrame = null) {
   makePlan();
   const g = shown.mesh.geometry;
   const position = g.getAttribute('position'), normal = g.getAttribute('normal');
@@ -211,8 +229,9 @@ export function applyMoved(movable, moved) {
     p[3 * d] = meshPositions[3 * v]; p[3 * d + 1] = meshPositions[3 * v + 1]; p[3 * d + 2] = meshPositions[3 * v + 2];
   }
   // A frame of the region before (an answer that crossed a new region's plan): the plain sums.
-  if (planInWasm && planInWasm.movable === movable && moved.length === 3 * movable.length)
-    planInWasm.update(p, moved, normal.array);
+  const frameOfPlan = moved.length === 3 * movable.length;
+  if (fromFrame && fromFrame.movable === movable && frameOfPlan) fromFrame.update(p, normal.array);
+  else if (planInWasm && planInWasm.movable === movable && frameOfPlan) planInWasm.update(p, moved, normal.array);
   else updateNormals(p, g.getIndex().array, normal.array, plan);
   if (plan.last < plan.first) return;
   touch(position, plan.first, plan.last);

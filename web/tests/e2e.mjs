@@ -135,6 +135,11 @@ async function core(page, log) {
   const normalsEngine = await page.evaluate(() => window.remora.normalsEngine());
   check(normalError < 1e-5 && normalsEngine === await page.evaluate(() => window.remora.kernelEngine()),
         `after the drag the page's normals (${normalsEngine}) equal a full computeVertexNormals() (off by ${normalError.toExponential(2)})`);
+  if (normalsEngine === 'wasm') {
+    const frameNormalError = await page.evaluate(() => window.remora.frameNormalError());
+    check(frameNormalError !== null && frameNormalError < 1e-5,
+          `the page's frame computes the drawn normals on its threads as a full computeVertexNormals() does (off by ${frameNormalError?.toExponential(2)})`);
+  }
   await shot(page, large ? 'editor-large-dragged.png' : 'editor-dragged.png');
   if (!large) {
     // The hidden base and its wireframe coloured by vertex area.
