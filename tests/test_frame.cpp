@@ -77,7 +77,7 @@ TEST(Frame, RegionNormalsAreTheWholeMeshsBitForBitAndNothingElseIsWritten) {
 
   FrameRows frame = frame_rows(positions, Eigen::MatrixXd::Constant(positions.rows(), 3, 7.0));
   std::vector<double> scratch;
-  update_normals(topology, plan, frame, scratch, 2);
+  update_normals(plan, frame, scratch, 2);
   const Eigen::MatrixXd all = vertex_normals(topology, positions);
   EXPECT_EQ(Eigen::MatrixXd(frame.leftCols<3>()), positions); // positions untouched
   std::vector<char> in_cap(positions.rows(), 0);
@@ -113,10 +113,21 @@ TEST(Frame, TheFramesDecodeIsDecodePhongsBitForBit) {
   for (std::size_t i = 0; i < outputs.size(); ++i) outputs[i] = static_cast<int>(2 * i + 1);
   const FrameRows frame = frame_rows(positions, normals);
   Eigen::MatrixXd out = Eigen::MatrixXd::Zero(2 * static_cast<Eigen::Index>(details.size()) + 1, 3);
-  decode_details(topology, frame, frame_details(details, outputs, true), out, 2);
-  std::vector<Eigen::Vector3d> added(details.size(), Eigen::Vector3d(1.0, 2.0, 3.0));
+  const FrameDetails records = frame_details(topology, details, outputs, true);
+  // In the order of their faces' first corners, each with its face's corners.
+  for (std::size_t i = 0; i < records.records.size(); ++i) {
+    const FrameDetails::Record& r = records.records[i];
+    EXPECT_EQ(r.corners, topology.faces[static_cast<std::size_t>(r.face)]) << i;
+    if (i > 0) {
+      EXPECT_LE(records.records[i - 1].corners[0], r.corners[0]) << i;
+    }
+  }
+  decode_details(frame, records, out, 2);
+  std::vector<Eigen::Vector3d> added;
+  for (std::size_t i = 0; i < details.size(); ++i)
+    added.emplace_back(0.001 * double(i), 1.0, -0.002 * double(i));
   Eigen::MatrixXd feet = out;
-  decode_details(topology, frame, frame_details(details, outputs, false, added), feet, 2);
+  decode_details(frame, frame_details(topology, details, outputs, false, added), feet, 2);
   for (std::size_t i = 0; i < details.size(); ++i) {
     const Eigen::Vector3d a = decode_phong(topology, positions, normals, details[i]);
     EXPECT_EQ(Eigen::Vector3d(out.row(outputs[i])), a) << i;

@@ -21,6 +21,18 @@ void parallel_for(std::size_t n, int threads, Body&& body) {
   for (long i = 0; i < count; ++i) body(static_cast<std::size_t>(i));
 }
 
+/// Runs body(i) for i in [0, n) on `threads` threads (0 = all hardware threads), each thread over
+/// one contiguous range of about n / threads indices; small loops run on the calling thread. For
+/// loops of equal, memory-bound items (a frame's steps), where each thread then streams through
+/// its own part of the arrays and no index is handed out at run time.
+template <class Body>
+void parallel_for_static(std::size_t n, int threads, Body&& body) {
+  const long count = static_cast<long>(n);
+  const int team = threads > 0 ? threads : omp_get_max_threads();
+#pragma omp parallel for schedule(static) num_threads(team) if (team > 1 && n > 1024)
+  for (long i = 0; i < count; ++i) body(static_cast<std::size_t>(i));
+}
+
 /// Runs body(b) for b in [0, n) on `threads` threads (0 = all), one index at a time as threads
 /// become free, however small n is: for loops over a few large blocks of work.
 template <class Body>

@@ -291,10 +291,10 @@ void Editor::Impl::update(double budget_ms) {
   if (options.method == EditMethod::Nonlinear) deform_base(r, r.dirty, budget_ms);
   const auto t_normals = Clock::now();
   // Normals where they can change.
-  update_normals(topology, r.affected, r.frame, r.face_normals, threads);
+  update_normals(r.affected, r.frame, r.face_normals, threads);
   const auto t_decode = Clock::now();
   report.milliseconds["frame normals"] = ms_since(t_normals);
-  decode_details(topology, r.frame, r.details, r.current_positions, threads);
+  decode_details(r.frame, r.details, r.current_positions, threads);
   r.dirty = false;
   report.milliseconds["frame decode"] = ms_since(t_decode);
   report.milliseconds["frame"] = ms_since(t0);

@@ -266,8 +266,8 @@ void Editor::Impl::encode_details(RegionState& r, EditReport& out,
                         decode_phong(topology, r.rest, r.rest_normals, foot);
     }
   }
-  r.details =
-      frame_details(details, r.encoded, options.details == DetailMode::Normal, rest_offsets);
+  r.details = frame_details(topology, details, r.encoded, options.details == DetailMode::Normal,
+                            rest_offsets);
   out.milliseconds["encode"] = ms_since(t0);
 }
 

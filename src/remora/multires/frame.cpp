@@ -3,6 +3,7 @@
 #include <cassert>
 #include <cmath>
 #include <cstddef>
+#include <numeric>
 
 #include <Eigen/Geometry>
 #include <fmt/format.h>
@@ -14,8 +15,8 @@
 namespace remora {
 
 namespace {
-// How far ahead decode_details() and update_normals() prefetch a face, and that face's rows.
-constexpr std::size_t kFacePrefetch = 16, kRowPrefetch = 8;
+// How far ahead decode_details() and update_normals() prefetch a face's rows.
+constexpr std::size_t kRowPrefetch = 8;
 
 // The rows of a face's corners (48 bytes each, across two cache lines for some).
 void prefetch_rows(const FrameRows& frame, const std::array<int, 3>& face) {
@@ -44,7 +45,7 @@ void blend_basis(const BasisRows& basis, const Eigen::MatrixXd& coefficients,
   assert(basis.rows() == static_cast<Eigen::Index>(free_vertices.size()));
   assert(basis.cols() == coefficients.rows() && coefficients.cols() == 3);
   const Eigen::Index m = basis.cols();
-  parallel_for(free_vertices.size(), threads, [&](std::size_t row) {
+  parallel_for_static(free_vertices.size(), threads, [&](std::size_t row) {
     const double* b = basis.data() + static_cast<Eigen::Index>(row) * m;
     double x = 0.0, y = 0.0, z = 0.0;
     for (Eigen::Index k = 0; k < m; ++k) {
@@ -73,6 +74,7 @@ NormalPlan plan_normals(const TriangleTopology& topology, const std::vector<int>
       if (s < 0) {
         s = static_cast<int>(plan.faces.size());
         plan.faces.push_back(f);
+        plan.corners.push_back(topology.faces[static_cast<std::size_t>(f)]);
       }
       plan.ring.push_back(s);
     }
@@ -81,27 +83,24 @@ NormalPlan plan_normals(const TriangleTopology& topology, const std::vector<int>
   return plan;
 }
 
-void update_normals(const TriangleTopology& topology, const NormalPlan& plan, FrameRows& frame,
-                    std::vector<double>& scratch, int threads) {
+void update_normals(const NormalPlan& plan, FrameRows& frame, std::vector<double>& scratch,
+                    int threads) {
   scratch.resize(3 * plan.faces.size());
   const auto position = [&](int v) {
     const double* p = frame.data() + 6 * static_cast<Eigen::Index>(v);
     return Eigen::Vector3d(p[0], p[1], p[2]);
   };
   const std::size_t faces = plan.faces.size();
-  parallel_for(faces, threads, [&](std::size_t i) {
-    if (i + kFacePrefetch < faces)
-      __builtin_prefetch(&topology.faces[static_cast<std::size_t>(plan.faces[i + kFacePrefetch])]);
-    if (i + kRowPrefetch < faces)
-      prefetch_rows(frame, topology.faces[static_cast<std::size_t>(plan.faces[i + kRowPrefetch])]);
-    const auto& f = topology.faces[static_cast<std::size_t>(plan.faces[i])];
+  parallel_for_static(faces, threads, [&](std::size_t i) {
+    if (i + kRowPrefetch < faces) prefetch_rows(frame, plan.corners[i + kRowPrefetch]);
+    const auto& f = plan.corners[i];
     const Eigen::Vector3d p0 = position(f[0]);
     const Eigen::Vector3d n = (position(f[1]) - p0).cross(position(f[2]) - p0);
     scratch[3 * i] = n[0];
     scratch[3 * i + 1] = n[1];
     scratch[3 * i + 2] = n[2];
   });
-  parallel_for(plan.vertices.size(), threads, [&](std::size_t i) {
+  parallel_for_static(plan.vertices.size(), threads, [&](std::size_t i) {
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
     for (int k = plan.ring_begin[i]; k < plan.ring_begin[i + 1]; ++k) {
       const auto s = 3 * static_cast<std::size_t>(plan.ring[static_cast<std::size_t>(k)]);
@@ -116,41 +115,48 @@ void update_normals(const TriangleTopology& topology, const NormalPlan& plan, Fr
   });
 }
 
-FrameDetails frame_details(const std::vector<PhongDetail>& details, const std::vector<int>& outputs,
+FrameDetails frame_details(const TriangleTopology& topology,
+                           const std::vector<PhongDetail>& details, const std::vector<int>& outputs,
                            bool keep_offsets, const std::vector<Eigen::Vector3d>& added) {
   if (outputs.size() != details.size() || (!added.empty() && added.size() != details.size()))
     throw InvalidArgument(fmt::format("frame_details: {} details, {} outputs, {} added offsets",
                                       details.size(), outputs.size(), added.size()));
+  std::vector<std::size_t> order(details.size());
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  const auto first_corner = [&](std::size_t i) {
+    return topology.faces[static_cast<std::size_t>(details[i].base.face.idx())][0];
+  };
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return first_corner(a) < first_corner(b); });
   FrameDetails out;
-  out.outputs = outputs;
-  out.offsets = added;
   out.records.reserve(details.size());
-  for (const PhongDetail& d : details) {
-    FrameDetails::Record r{d.base.bary, keep_offsets ? d.offset : 0.0, d.base.face.idx(), -1};
+  out.outputs.reserve(details.size());
+  out.offsets.reserve(added.size());
+  for (const std::size_t i : order) {
+    const PhongDetail& d = details[i];
+    const int face = d.base.face.idx();
+    FrameDetails::Record r{d.base.bary, keep_offsets ? d.offset : 0.0, face, -1,
+                           topology.faces[static_cast<std::size_t>(face)]};
     if (keep_offsets && d.residual) {
       r.residual = static_cast<int>(out.residuals.size());
       out.residuals.push_back(d.frame);
     }
     out.records.push_back(r);
+    out.outputs.push_back(outputs[i]);
+    if (!added.empty()) out.offsets.push_back(added[i]);
   }
   return out;
 }
 
-void decode_details(const TriangleTopology& topology, const FrameRows& frame,
-                    const FrameDetails& details, Eigen::MatrixXd& positions, int threads) {
+void decode_details(const FrameRows& frame, const FrameDetails& details, Eigen::MatrixXd& positions,
+                    int threads) {
   const std::size_t count = details.records.size();
-  parallel_for(count, threads, [&](std::size_t i) {
-    // The gathers wait on memory: ask for a later record's face, and for the rows of the face
-    // of a nearer one (whose face was asked for earlier).
-    if (i + kFacePrefetch < count)
-      __builtin_prefetch(
-          &topology.faces[static_cast<std::size_t>(details.records[i + kFacePrefetch].face)]);
-    if (i + kRowPrefetch < count)
-      prefetch_rows(
-          frame, topology.faces[static_cast<std::size_t>(details.records[i + kRowPrefetch].face)]);
+  parallel_for_static(count, threads, [&](std::size_t i) {
+    // The gathers wait on memory: ask for the rows of a later record's face.
+    if (i + kRowPrefetch < count) prefetch_rows(frame, details.records[i + kRowPrefetch].corners);
     const FrameDetails::Record& r = details.records[i];
     Eigen::Vector3d x[3], n[3];
-    const auto& f = topology.faces[static_cast<std::size_t>(r.face)];
+    const auto& f = r.corners;
     for (int k = 0; k < 3; ++k) {
       const double* row =
           frame.data() + 6 * static_cast<Eigen::Index>(f[static_cast<std::size_t>(k)]);

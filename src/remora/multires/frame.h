@@ -33,10 +33,12 @@ void blend_basis(const BasisRows& basis, const Eigen::MatrixXd& coefficients,
                  const std::vector<int>& free_vertices, FrameRows& frame, int threads);
 
 /// What a frame's normals need, built once per region: `vertices`, whose normals can change;
-/// `faces`, every face around one of them; `ring`, for vertices[i] the positions in `faces` of its
-/// faces, ring[ring_begin[i] .. ring_begin[i + 1]), in the order of topology.vertex_faces.
+/// `faces`, every face around one of them, and `corners`, each of those faces' corners (read in
+/// sequence by a frame); `ring`, for vertices[i] the positions in `faces` of its faces,
+/// ring[ring_begin[i] .. ring_begin[i + 1]), in the order of topology.vertex_faces.
 struct NormalPlan {
   std::vector<int> vertices, faces, ring_begin, ring;
+  std::vector<std::array<int, 3>> corners;
 };
 
 /// The plan for the normals of `vertices` (base vertex ids).
@@ -46,17 +48,20 @@ NormalPlan plan_normals(const TriangleTopology& topology, const std::vector<int>
 /// vertex_normals() computes them (the same sums in the same order, so bit for bit the same):
 /// the normalized sum of the faces' cross products, (0, 0, 0) where it vanishes. `scratch` holds
 /// the faces' cross products between calls.
-void update_normals(const TriangleTopology& topology, const NormalPlan& plan, FrameRows& frame,
-                    std::vector<double>& scratch, int threads);
+void update_normals(const NormalPlan& plan, FrameRows& frame, std::vector<double>& scratch,
+                    int threads);
 
-/// The details of a region as the frame decodes them: per output, its base face, barycentric
-/// coordinates and offset; the rare residuals (phong.h) apart.
+/// The details of a region as the frame decodes them: per output, its base face (and that face's
+/// corners), barycentric coordinates and offset; the rare residuals (phong.h) apart. The records
+/// are in the order of their faces' first corners, so that a frame reads the base's rows nearly
+/// in sequence (and scatters its writes instead).
 struct FrameDetails {
   struct Record {
     std::array<double, 3> bary;
     double offset;
     int face;
     int residual; ///< index into `residuals`, or -1
+    std::array<int, 3> corners;
   };
   std::vector<Record> records;
   std::vector<std::array<double, 3>> residuals;
@@ -64,16 +69,17 @@ struct FrameDetails {
   std::vector<Eigen::Vector3d> offsets; ///< per record, added (DetailMode::Displacement), or empty
 };
 
-/// The frame's form of `details` (decoding into rows `outputs`). Without `keep_offsets` every
-/// detail decodes to its base point (offsets and residuals dropped: DetailMode::None and
-/// Displacement); `added`, when not empty, is added per detail. Throws InvalidArgument for
-/// mismatched sizes.
-FrameDetails frame_details(const std::vector<PhongDetail>& details, const std::vector<int>& outputs,
+/// The frame's form of `details` (decoding into rows `outputs`) on the base of `topology`. Without
+/// `keep_offsets` every detail decodes to its base point (offsets and residuals dropped:
+/// DetailMode::None and Displacement); `added`, when not empty, is added per detail. Throws
+/// InvalidArgument for mismatched sizes.
+FrameDetails frame_details(const TriangleTopology& topology,
+                           const std::vector<PhongDetail>& details, const std::vector<int>& outputs,
                            bool keep_offsets, const std::vector<Eigen::Vector3d>& added = {});
 
 /// positions.row(details.outputs[i]) = the decode of record i on `frame` for every i, the same
 /// doubles as decode_phong() on the frame's positions and normals. Parallel with `threads`.
-void decode_details(const TriangleTopology& topology, const FrameRows& frame,
-                    const FrameDetails& details, Eigen::MatrixXd& positions, int threads);
+void decode_details(const FrameRows& frame, const FrameDetails& details, Eigen::MatrixXd& positions,
+                    int threads);
 
 } // namespace remora
