@@ -50,7 +50,27 @@ export async function api(path, options = {}) {
   return response;
 }
 export const json = async (path, options) => (await api(path, options)).json();
-export const binary = async (path, Type) => new Type(await (await api(path)).arrayBuffer());
+/// A response's body as one ArrayBuffer, read from its stream (into a buffer of its
+/// Content-Length when it has one): chromium hands over the bunny's 420 KB of positions about
+/// 2 ms sooner this way than through response.arrayBuffer() (docs/server.md).
+export async function bodyBytes(response) {
+  const reader = response.body.getReader();
+  const length = parseInt(response.headers.get('Content-Length') ?? '', 10);
+  let out = new Uint8Array(Number.isFinite(length) && length >= 0 ? length : 0), size = 0;
+  for (;;) {
+    const { value, done } = await reader.read();
+    if (done) break;
+    if (size + value.byteLength > out.length) { // no (or a wrong) Content-Length: grow
+      const grown = new Uint8Array(Math.max(2 * out.length, size + value.byteLength));
+      grown.set(out.subarray(0, size));
+      out = grown;
+    }
+    out.set(value, size);
+    size += value.byteLength;
+  }
+  return size === out.length ? out.buffer : out.buffer.slice(0, size);
+}
+export const binary = async (path, Type) => new Type(await bodyBytes(await api(path)));
 export const post = (path, body) => api(path, { method: 'POST', headers: { 'Content-Type': 'application/json' },
                                                 body: JSON.stringify(body ?? {}) });
 

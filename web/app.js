@@ -5,7 +5,7 @@
 // view.js draws, api.js talks to the server, picking.js asks it what is under the pointer,
 // panels.js is the panel and the keyboard.
 import * as THREE from 'three';
-import { ApiError, api, binary, compactIds, json, message, post, task, waitUntilReady, work } from './api.js';
+import { ApiError, api, binary, bodyBytes, compactIds, json, message, post, task, waitUntilReady, work } from './api.js';
 import * as view from './view.js';
 import { FIXED, FREE } from './view.js';
 import { Coalescer, faceNormal, pick } from './picking.js';
@@ -131,7 +131,7 @@ function loadKernel(s) {
   const computable = s.region?.method === 'linear' || s.region?.energy === 'blended-motions';
   if (!pageFrames || !computable || !state.movable) return;
   const regionId = s.region_id, movable = state.movable;
-  Promise.all([fetch('api/region/kernel').then((r) => (r.ok ? r.arrayBuffer() : null)), engineLoaded]).then(([buffer]) => {
+  Promise.all([fetch('api/region/kernel').then((r) => (r.ok ? bodyBytes(r) : null)), engineLoaded]).then(([buffer]) => {
     if (!buffer || state.held.region !== regionId || state.movable !== movable) return;
     const data = parseKernel(buffer, view.drawnNormals(movable));
     releaseKernel(kernel?.data);
@@ -413,7 +413,7 @@ async function sendFrame(request) {
                                body: JSON.stringify({ handle: request.handle, matrix: request.matrix,
                                                       answer: request.local ? 'none' : 'positions' }) });
   if (!response.ok) throw new ApiError(response.status, 'relax refused');
-  const buffer = await response.arrayBuffer();
+  const buffer = await bodyBytes(response);
   return { moved: new Float32Array(buffer), bytes: buffer.byteLength, ms: parseFloat(response.headers.get('X-Frame-Ms')),
            converged: response.headers.get('X-Converged') !== '0' };
 }

@@ -1,7 +1,7 @@
 // Picking and brushes, done by the server (POST /api/pick, docs/server.md) on the positions it
 // holds: the face under a ray, its point and nearest corner, and the vertices within a radius of
 // that point (geodesic distance along the surface, or Euclidean for the "sphere" brush).
-import { api } from './api.js';
+import { api, bodyBytes } from './api.js';
 
 /// One pick: ray { origin, direction } (world space), radius >= 0, brush 'geodesic' | 'sphere',
 /// stroke: a number for the picks of one paint stroke (the server then answers only the vertices
@@ -13,7 +13,7 @@ export async function pick(ray, radius, brush, stroke) {
     method: 'POST', headers: { 'Content-Type': 'application/json' },
     body: JSON.stringify({ origin: ray.origin, direction: ray.direction, radius, brush, stroke }),
   });
-  const ids = new Uint32Array(await response.arrayBuffer());
+  const ids = new Uint32Array(await bodyBytes(response));
   const face = parseInt(response.headers.get('X-Hit-Face') ?? '-1', 10);
   const point = face >= 0 ? (response.headers.get('X-Hit-Point') ?? '').trim().split(/\s+/).map(Number) : null;
   const vertex = face >= 0 ? parseInt(response.headers.get('X-Hit-Vertex') ?? '-1', 10) : -1;
