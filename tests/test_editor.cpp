@@ -296,6 +296,66 @@ TEST(Editor, ASupportOfLongTrianglesIsReported) {
   EXPECT_EQ(to_json(r)["region"]["coarse_support"], r.coarse_support);
 }
 
+// The region's figures, computed by set_region from the painted vertices' neighbourhoods, equal
+// their definitions evaluated over the whole mesh and base: a base vertex takes the label of its
+// nearest input corner, then each painted input vertex claims its nearest base vertex (a handle
+// over the support, the lower handle over the higher); the longest edge with both ends painted.
+TEST(Editor, TheRegionsFiguresAreTheirDefinitionsOverTheWholeMesh) {
+  const Mesh mesh = bumpy_sphere(3);
+  const auto support = sphere_ids(mesh, Vec3(0, 0, 1), 0.9);
+  // On a base coarser than the input a one-vertex handle has no base vertex of its own: its
+  // claim gives it one.
+  const std::vector<std::vector<int>> handles = {sphere_ids(mesh, Vec3(0, 0.2, 1), 0.15),
+                                                 {sphere_ids(mesh, Vec3(0, -0.3, 1), 0.1).at(0)}};
+  EditorOptions options;
+  options.remesh_options.target_length = 2.5 * mean_edge_length(mesh);
+  Editor editor(mesh, options);
+  editor.set_region(support, handles);
+  const EditorPartsView parts = editor.parts();
+  std::vector<int> input_label(mesh.n_vertices(), Region::kFixed);
+  for (const int v : support) input_label[static_cast<std::size_t>(v)] = Region::kFree;
+  for (std::size_t j = 0; j < handles.size(); ++j)
+    for (const int v : handles[j]) input_label[static_cast<std::size_t>(v)] = int(j);
+  const auto nearest = [](const std::array<double, 3>& b) {
+    return b[0] >= b[1] && b[0] >= b[2] ? 0 : b[1] >= b[2] ? 1 : 2;
+  };
+  std::vector<int> base_label(parts.base.n_vertices());
+  for (std::size_t v = 0; v < base_label.size(); ++v) {
+    const SurfacePoint& sp = parts.base_on_input[v];
+    base_label[v] =
+        input_label[static_cast<std::size_t>(parts.input_topology.faces[static_cast<std::size_t>(
+            sp.face.idx())][static_cast<std::size_t>(nearest(sp.bary))])];
+  }
+  for (std::size_t i = 0; i < input_label.size(); ++i) {
+    const SurfacePoint& sp = parts.input_on_base[i];
+    const int label = input_label[i];
+    if (label == Region::kFixed || !sp.face.is_valid()) continue;
+    int& b = base_label[static_cast<std::size_t>(parts.topology.faces[static_cast<std::size_t>(
+        sp.face.idx())][static_cast<std::size_t>(nearest(sp.bary))])];
+    if (label >= 0 ? b < 0 || label < b : b == Region::kFixed) b = label;
+  }
+  std::size_t free_count = 0, constrained = 0;
+  std::vector<std::size_t> per_handle(handles.size(), 0);
+  for (const int label : base_label) {
+    (label == Region::kFree ? free_count : constrained)++;
+    if (label >= 0) ++per_handle[static_cast<std::size_t>(label)];
+  }
+  const EditReport& r = editor.report();
+  EXPECT_EQ(r.free_base_vertices, free_count);
+  EXPECT_EQ(r.constrained_base_vertices, constrained);
+  EXPECT_EQ(r.handle_base_vertices, per_handle);
+  double longest = 0.0;
+  for (const auto& f : parts.input_topology.faces)
+    for (std::size_t k = 0; k < 3; ++k) {
+      const int a = f[k], b = f[(k + 1) % 3];
+      if (input_label[static_cast<std::size_t>(a)] != Region::kFixed &&
+          input_label[static_cast<std::size_t>(b)] != Region::kFixed)
+        longest =
+            std::max(longest, (parts.input_positions.row(a) - parts.input_positions.row(b)).norm());
+    }
+  EXPECT_DOUBLE_EQ(r.support_edge_ratio, longest / r.base_target_length);
+}
+
 TEST(Editor, ErrorsNameTheProblem) {
   const Mesh mesh = bumpy_sphere(3);
   Editor editor(mesh);

@@ -150,6 +150,7 @@ Editor::Editor(Mesh mesh, EditorOptions options) : impl_(std::make_unique<Impl>(
   m.report.base_symmetry_defect = laplacian_symmetry_defect(m.base);
   m.report.base_quality = mesh_quality(m.base);
   m.statistics = base_statistics(m.base);
+  m.index_base_nearest();
   m.report.milliseconds["base report"] = ms_since(t0);
 }
 
@@ -174,6 +175,7 @@ Editor::Editor(const std::function<void(EditorParts&)>& build, EditorOptions opt
     m.statistics = base_statistics(m.base);
   if (!m.assembler || m.assembler->vertex_count() != m.base.n_vertices())
     m.assembler.emplace(m.base, m.options.threads);
+  m.index_base_nearest();
 }
 
 Editor::Editor(Editor&&) noexcept = default;

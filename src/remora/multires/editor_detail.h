@@ -63,6 +63,12 @@ struct Editor::Impl : EditorParts {
   std::unique_ptr<MultigridSolver> multigrid;
   std::shared_ptr<const RemeshResult> coarse; // method nonlinear's preview level, for every region
   std::unique_ptr<RegionState> region;
+  // For each input vertex i, the base vertices whose location on the input (base_on_input) has
+  // i as its nearest corner: base_nearest[base_nearest_begin[i] .. base_nearest_begin[i + 1]).
+  // Built once per editor (index_base_nearest()), so that mapping a region visits its own
+  // vertices, not the whole base.
+  std::vector<int> base_nearest_begin, base_nearest;
+  void index_base_nearest();
   // The regions installed before the current one, the latest first: set_region() of one of them
   // again (an undo) installs it as it was, without the work.
   std::deque<std::unique_ptr<RegionState>> recent;

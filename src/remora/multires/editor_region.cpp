@@ -70,27 +70,50 @@ Editor::Impl::paint(const std::vector<int>& support,
   return state;
 }
 
+void Editor::Impl::index_base_nearest() {
+  const std::size_t ni = input.n_vertices(), nb = base_on_input.size();
+  std::vector<int> corner(nb);
+  base_nearest_begin.assign(ni + 1, 0);
+  for (std::size_t v = 0; v < nb; ++v) {
+    const SurfacePoint& sp = base_on_input[v];
+    corner[v] = sp.face.is_valid()
+                    ? input_topology.faces[static_cast<std::size_t>(sp.face.idx())]
+                                          [static_cast<std::size_t>(largest(sp.bary))]
+                    : -1; // an isolated vertex without --remesh: on no face
+    if (corner[v] >= 0) ++base_nearest_begin[static_cast<std::size_t>(corner[v]) + 1];
+  }
+  for (std::size_t i = 0; i < ni; ++i) base_nearest_begin[i + 1] += base_nearest_begin[i];
+  std::vector<int> fill(base_nearest_begin.begin(), base_nearest_begin.end() - 1);
+  base_nearest.resize(static_cast<std::size_t>(base_nearest_begin[ni]));
+  for (std::size_t v = 0; v < nb; ++v)
+    if (corner[v] >= 0)
+      base_nearest[static_cast<std::size_t>(fill[static_cast<std::size_t>(corner[v])]++)] =
+          static_cast<int>(v);
+}
+
 // Maps the region onto the base: a base vertex takes the label of the input vertex nearest to
 // its location (largest barycentric weight); then every painted input vertex claims the base
-// vertex nearest to its own location, so that small handles and supports are not lost.
+// vertex nearest to its own location, so that small handles and supports are not lost (a handle
+// over the support, and of two handles the one of lower index).
 void Editor::Impl::map_to_base(RegionState& r) const {
   const auto nb = static_cast<std::size_t>(base.n_vertices());
   r.base_label.assign(nb, Region::kFixed);
   if (options.remesh) {
-    for (std::size_t v = 0; v < nb; ++v) {
-      const SurfacePoint& sp = base_on_input[v];
-      const int corner = input_topology.faces[static_cast<std::size_t>(sp.face.idx())]
-                                             [static_cast<std::size_t>(largest(sp.bary))];
-      r.base_label[v] = r.input_label[static_cast<std::size_t>(corner)];
-    }
-    for (std::size_t i = 0; i < r.input_label.size(); ++i) {
+    // Only the painted vertices' base vertices take a label other than kFixed.
+    for (const int i : r.support)
+      for (int k = base_nearest_begin[static_cast<std::size_t>(i)];
+           k < base_nearest_begin[static_cast<std::size_t>(i) + 1]; ++k)
+        r.base_label[static_cast<std::size_t>(base_nearest[static_cast<std::size_t>(k)])] =
+            r.input_label[static_cast<std::size_t>(i)];
+    for (const int v : r.support) {
+      const auto i = static_cast<std::size_t>(v);
       const int label = r.input_label[i];
       const SurfacePoint& sp = input_on_base[i];
       if (label == Region::kFixed || !sp.face.is_valid()) continue;
       const int w = topology.faces[static_cast<std::size_t>(sp.face.idx())]
                                   [static_cast<std::size_t>(largest(sp.bary))];
       int& bl = r.base_label[static_cast<std::size_t>(w)];
-      if (label >= 0 ? bl < 0 : bl == Region::kFixed) bl = label;
+      if (label >= 0 ? bl < 0 || label < bl : bl == Region::kFixed) bl = label;
     }
   } else {
     r.base_label = r.input_label;
@@ -116,15 +139,21 @@ void Editor::Impl::report_region(const RegionState& r, EditReport& out) const {
   out.handle_base_vertices.clear();
   for (const auto& h : r.handle_base) out.handle_base_vertices.push_back(h.size());
   // The support's own edges against the base's: a support of long triangles bends in facets.
+  // Every edge with both ends painted leaves a painted vertex in one of its faces (as the side
+  // from a face's corner to the next).
   double longest = 0.0;
-  for (const auto& f : input_topology.faces)
-    for (int k = 0; k < 3; ++k) {
-      const int a = f[static_cast<std::size_t>(k)], b = f[static_cast<std::size_t>((k + 1) % 3)];
-      if (r.input_label[static_cast<std::size_t>(a)] == Region::kFixed ||
-          r.input_label[static_cast<std::size_t>(b)] == Region::kFixed)
-        continue;
-      longest = std::max(longest, (input_positions.row(a) - input_positions.row(b)).norm());
+  for (const int v : r.support) {
+    const auto u = static_cast<std::size_t>(v);
+    const Eigen::Vector3d p = input_positions.row(v).transpose();
+    for (int i = input_topology.vertex_offsets[u]; i < input_topology.vertex_offsets[u + 1]; ++i) {
+      const auto& f =
+          input_topology.faces[static_cast<std::size_t>(input_topology.vertex_faces[i])];
+      const std::size_t k = f[0] == v ? 0 : f[1] == v ? 1 : 2;
+      const int b = f[(k + 1) % 3];
+      if (r.input_label[static_cast<std::size_t>(b)] != Region::kFixed)
+        longest = std::max(longest, (input_positions.row(b).transpose() - p).norm());
     }
+  }
   const double unit =
       out.base_target_length > 0.0 ? out.base_target_length : mean_edge_length(base);
   out.support_edge_ratio = unit > 0.0 ? longest / unit : 0.0;
@@ -274,11 +303,14 @@ void Editor::Impl::encode_details(RegionState& r, EditReport& out,
 // The base vertices whose normals can change: every corner of a face with a moving vertex.
 void Editor::Impl::find_affected(RegionState& r) const {
   std::vector<char> affected(base.n_vertices(), 0);
-  for (const auto& f : topology.faces)
-    if (r.base_label[static_cast<std::size_t>(f[0])] != Region::kFixed ||
-        r.base_label[static_cast<std::size_t>(f[1])] != Region::kFixed ||
-        r.base_label[static_cast<std::size_t>(f[2])] != Region::kFixed)
-      for (const int v : f) affected[static_cast<std::size_t>(v)] = 1;
+  for (std::size_t u = 0; u < affected.size(); ++u) {
+    if (r.base_label[u] == Region::kFixed) continue;
+    for (int i = topology.vertex_offsets[u]; i < topology.vertex_offsets[u + 1]; ++i)
+      for (const int v :
+           topology
+               .faces[static_cast<std::size_t>(topology.vertex_faces[static_cast<std::size_t>(i)])])
+        affected[static_cast<std::size_t>(v)] = 1;
+  }
   std::vector<int> vertices;
   for (std::size_t v = 0; v < affected.size(); ++v)
     if (affected[v]) vertices.push_back(static_cast<int>(v));
