@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <map>
 #include <random>
 #include <stop_token>
 #include <string>
@@ -354,6 +355,49 @@ TEST(Editor, TheRegionsFiguresAreTheirDefinitionsOverTheWholeMesh) {
             std::max(longest, (parts.input_positions.row(a) - parts.input_positions.row(b)).norm());
     }
   EXPECT_DOUBLE_EQ(r.support_edge_ratio, longest / r.base_target_length);
+}
+
+// Two handles painted so close that every base vertex of the second is the first's: the second
+// would move nothing, and set_region says so instead.
+TEST(Editor, AHandleWithoutABaseVertexOfItsOwnIsRefused) {
+  const Mesh mesh = bumpy_sphere(3);
+  EditorOptions options;
+  options.remesh_options.target_length = 2.5 * mean_edge_length(mesh);
+  Editor editor(mesh, options);
+  const EditorPartsView parts = editor.parts();
+  const auto support = sphere_ids(mesh, Vec3(0, 0, 1), 0.9);
+  const auto nearest = [](const std::array<double, 3>& b) {
+    return b[0] >= b[1] && b[0] >= b[2] ? 0 : b[1] >= b[2] ? 1 : 2;
+  };
+  // The input vertices that are the nearest corner of some base vertex's location.
+  std::vector<char> someones_corner(mesh.n_vertices(), 0);
+  for (const SurfacePoint& sp : parts.base_on_input)
+    someones_corner[static_cast<std::size_t>(parts.input_topology.faces[static_cast<std::size_t>(
+        sp.face.idx())][static_cast<std::size_t>(nearest(sp.bary))])] = 1;
+  // Two support vertices whose nearest base vertex is the same one, the second no base vertex's
+  // nearest corner.
+  std::map<int, int> first_at;
+  std::vector<std::vector<int>> handles;
+  for (const int v : support) {
+    if (someones_corner[static_cast<std::size_t>(v)]) continue;
+    const SurfacePoint& sp = parts.input_on_base[static_cast<std::size_t>(v)];
+    const int w = parts.topology.faces[static_cast<std::size_t>(sp.face.idx())]
+                                      [static_cast<std::size_t>(nearest(sp.bary))];
+    const auto [at, added] = first_at.emplace(w, v);
+    if (!added) {
+      handles = {{at->second}, {v}};
+      break;
+    }
+  }
+  ASSERT_EQ(handles.size(), 2u) << "no two support vertices share a nearest base vertex";
+  try {
+    editor.set_region(support, handles);
+    FAIL() << "set_region accepted a handle without a base vertex";
+  } catch (const InvalidArgument& e) {
+    EXPECT_NE(std::string(e.what()).find("handle 1 has no vertex of its own"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_EQ(editor.handle_count(), 0); // no region was installed
 }
 
 TEST(Editor, ErrorsNameTheProblem) {

@@ -131,10 +131,10 @@ export function releaseKernel(k) {
   k?.wasm?.threads.stop();
 }
 
-/// Puts the records in the order of their faces' first corners. The server sends them in the
-/// order of their outputs (the input's vertex order, which can be anywhere in the base: a
-/// subdivided scan's is), and the decode then reads its three rows from anywhere; in this order
-/// it reads them nearly in sequence and scatters only its writes. The frames are the same numbers.
+/// Puts the records in the order of their faces' first corners in the kernel's local numbering.
+/// The server sends them in the order of the first corners' base ids (multires/frame.h), which
+/// the local numbering need not follow; in this order the decode reads its three rows nearly in
+/// sequence and scatters only its writes. The frames are the same numbers.
 function sortRecords(k) {
   const order = Uint32Array.from({ length: k.records }, (_, i) => i);
   const first = (i) => k.faces[3 * k.recordFace[i]];
