@@ -8,6 +8,7 @@
 
 #if defined(__GLIBC__)
 #include <malloc.h>
+#include <sys/resource.h>
 #endif
 
 #include <gtest/gtest.h>
@@ -93,6 +94,30 @@ TEST(Memory, KeepFreedMemoryServesAnotherThreadsLargeBlocksFromTheHeap) {
   }).join();
   EXPECT_EQ(mapped_during, mapped_before)
       << "the thread's block was mapped, not taken from the heap";
+#endif
+}
+
+// After warm_heap(64 MiB), a block of 48 MiB comes from warm pages: writing all of it faults in
+// almost nothing (without the warming, about 12,000 pages of 4 KiB).
+TEST(Memory, WarmHeapLeavesPagesThatALaterBlockReusesWithoutFaults) {
+#if !defined(__GLIBC__) || defined(REMORA_TEST_ASAN)
+  GTEST_SKIP() << "glibc's allocator only (the sanitizers bring their own)";
+#else
+  ASSERT_TRUE(keep_freed_memory());
+  const std::size_t page = 4096, warm = std::size_t{64} << 20, later = std::size_t{48} << 20;
+  warm_heap(warm);
+  const auto faults = [] {
+    rusage u{};
+    getrusage(RUSAGE_SELF, &u);
+    return static_cast<std::uint64_t>(u.ru_minflt);
+  };
+  const std::uint64_t before = faults();
+  {
+    std::vector<char> block(later, 1);
+    EXPECT_EQ(block[later - 1], 1);
+  }
+  EXPECT_LT(faults() - before, later / page / 20) << "the block was not served from warm pages";
+  EXPECT_LT(warm_heap(warm), warm / page / 20) << "warming warm pages again faulted";
 #endif
 }
 

@@ -8,12 +8,14 @@
 
 #include <fmt/format.h>
 
+#include "remora/common/memory.h"
 #include "remora/common/timer.h"
 #include "remora/geometry/measures.h"
 #include "remora/geometry/quality.h"
 #include "remora/linalg/kharmonic.h"
 #include "remora/mesh/io.h"
 #include "remora/multires/bake.h"
+#include "remora/multires/limits.h"
 
 namespace remora::server {
 
@@ -390,6 +392,8 @@ void Session::start_load(std::string bytes, std::string name) {
     LoadResult loaded = read_mesh_from_memory(bytes, format, name, {}, m.options.read);
     auto shape = std::make_shared<Shape>(loaded.mesh);
     auto box = std::make_shared<EditorBox>(Editor(std::move(loaded.mesh), m.editor_options()));
+    // The first regions' factors then find warm pages (common/memory.h).
+    warm_heap(warm_heap_bytes(box->editor.base().n_vertices(), box->editor.options().system.k));
     box->preprocess_ms = ms_since(t0);
     std::lock_guard guard(m.mutex);
     m.box = box;

@@ -1,5 +1,6 @@
 #include "remora/common/memory.h"
 
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include <cstdlib> // defines __GLIBC__ under glibc
@@ -26,6 +27,22 @@ bool keep_freed_memory() {
 #else
   return false;
 #endif
+}
+
+std::uint64_t warm_heap(std::size_t bytes) {
+  const auto faults = [] {
+    rusage u{};
+    getrusage(RUSAGE_SELF, &u);
+    return static_cast<std::uint64_t>(u.ru_minflt);
+  };
+  const std::uint64_t before = faults();
+  auto* block = static_cast<volatile char*>(std::malloc(bytes));
+  if (block == nullptr) return 0;
+  const auto page =
+      static_cast<std::size_t>(sysconf(_SC_PAGESIZE) > 0 ? sysconf(_SC_PAGESIZE) : 4096);
+  for (std::size_t i = 0; i < bytes; i += page) block[i] = 0;
+  std::free(const_cast<char*>(block));
+  return faults() - before;
 }
 
 } // namespace remora

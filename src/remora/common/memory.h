@@ -1,6 +1,7 @@
 // Process-wide allocator settings for the apps (the library itself never calls this).
 #pragma once
 
+#include <cstddef>
 #include <cstdint>
 
 namespace remora {
@@ -19,5 +20,14 @@ std::uint64_t physical_memory_bytes();
 /// settings hold for the whole process, a host program's own threads included. A no-op where
 /// the C library is not glibc. Returns whether the settings took effect.
 bool keep_freed_memory();
+
+/// Allocates `bytes`, writes a byte of every page and frees them, so that under
+/// keep_freed_memory() a later allocation of up to that size finds pages already faulted in. On
+/// a VM where a page's first touch costs about 10 µs, a region's factor of 40-50 MB otherwise
+/// pays 0.1 s in page faults (docs/benchmarks.md). Cheap where the heap already holds a free
+/// block that large (its pages are warm). Returns the page faults it took (getrusage's minor
+/// faults of the process, so other threads' count too); 0 and nothing done when the allocation
+/// fails.
+std::uint64_t warm_heap(std::size_t bytes);
 
 } // namespace remora

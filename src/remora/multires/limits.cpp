@@ -20,4 +20,8 @@ std::uint64_t region_bytes(std::size_t free_vertices, int k, int handles) {
   return per_vertex * free_vertices;
 }
 
+std::uint64_t warm_heap_bytes(std::size_t base_vertices, int k) {
+  return std::min(region_bytes(base_vertices, k, 1), kWarmHeapBytes);
+}
+
 } // namespace remora

@@ -41,6 +41,13 @@ std::uint64_t editor_triangle_limit(std::uint64_t memory_bytes, int editors = 1)
 /// `handles` handles (each handle beyond the first adds 4 basis columns and 4 solutions).
 std::uint64_t region_bytes(std::size_t free_vertices, int k, int handles);
 
+/// How much heap an app warms after building an editor (common/memory.h, warm_heap()): a
+/// region over every base vertex at order k (region_bytes), at most kWarmHeapBytes. The first
+/// regions then fault in no fresh pages: on the bunny set_region took 150-160 ms instead of
+/// 300-340 ms for the first region and 180-220 ms for the next (docs/benchmarks.md).
+inline constexpr std::uint64_t kWarmHeapBytes = std::uint64_t(256) << 20;
+std::uint64_t warm_heap_bytes(std::size_t base_vertices, int k);
+
 /// The handles an edit may have. Each handle adds four solutions to set_region and four columns
 /// per free vertex to the basis every frame blends (n_free x (3 + 4h) doubles): at 16 handles a
 /// region of 549k free base vertices (all of igea_sub4) holds a basis of 290 MB.
