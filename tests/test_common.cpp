@@ -8,7 +8,6 @@
 
 #if defined(__GLIBC__)
 #include <malloc.h>
-#include <sys/resource.h>
 #endif
 
 #include <gtest/gtest.h>
@@ -106,17 +105,13 @@ TEST(Memory, WarmHeapLeavesPagesThatALaterBlockReusesWithoutFaults) {
   ASSERT_TRUE(keep_freed_memory());
   const std::size_t page = 4096, warm = std::size_t{64} << 20, later = std::size_t{48} << 20;
   warm_heap(warm);
-  const auto faults = [] {
-    rusage u{};
-    getrusage(RUSAGE_SELF, &u);
-    return static_cast<std::uint64_t>(u.ru_minflt);
-  };
-  const std::uint64_t before = faults();
+  const std::uint64_t before = minor_page_faults();
   {
     std::vector<char> block(later, 1);
     EXPECT_EQ(block[later - 1], 1);
   }
-  EXPECT_LT(faults() - before, later / page / 20) << "the block was not served from warm pages";
+  EXPECT_LT(minor_page_faults() - before, later / page / 20)
+      << "the block was not served from warm pages";
   EXPECT_LT(warm_heap(warm), warm / page / 20) << "warming warm pages again faulted";
 #endif
 }

@@ -54,6 +54,11 @@ Mesh bumpy_plane(int n, double wavelength, double amplitude) {
   return m;
 }
 
+// The corner of the largest barycentric weight (the nearest corner of a surface point).
+int nearest_corner(const std::array<double, 3>& b) {
+  return b[0] >= b[1] && b[0] >= b[2] ? 0 : b[1] >= b[2] ? 1 : 2;
+}
+
 std::vector<int> sphere_ids(const Mesh& m, Vec3 c, double r) {
   return select_sphere(m, c, r);
 }
@@ -317,22 +322,19 @@ TEST(Editor, TheRegionsFiguresAreTheirDefinitionsOverTheWholeMesh) {
   for (const int v : support) input_label[static_cast<std::size_t>(v)] = Region::kFree;
   for (std::size_t j = 0; j < handles.size(); ++j)
     for (const int v : handles[j]) input_label[static_cast<std::size_t>(v)] = int(j);
-  const auto nearest = [](const std::array<double, 3>& b) {
-    return b[0] >= b[1] && b[0] >= b[2] ? 0 : b[1] >= b[2] ? 1 : 2;
-  };
   std::vector<int> base_label(parts.base.n_vertices());
   for (std::size_t v = 0; v < base_label.size(); ++v) {
     const SurfacePoint& sp = parts.base_on_input[v];
     base_label[v] =
         input_label[static_cast<std::size_t>(parts.input_topology.faces[static_cast<std::size_t>(
-            sp.face.idx())][static_cast<std::size_t>(nearest(sp.bary))])];
+            sp.face.idx())][static_cast<std::size_t>(nearest_corner(sp.bary))])];
   }
   for (std::size_t i = 0; i < input_label.size(); ++i) {
     const SurfacePoint& sp = parts.input_on_base[i];
     const int label = input_label[i];
     if (label == Region::kFixed || !sp.face.is_valid()) continue;
     int& b = base_label[static_cast<std::size_t>(parts.topology.faces[static_cast<std::size_t>(
-        sp.face.idx())][static_cast<std::size_t>(nearest(sp.bary))])];
+        sp.face.idx())][static_cast<std::size_t>(nearest_corner(sp.bary))])];
     if (label >= 0 ? b < 0 || label < b : b == Region::kFixed) b = label;
   }
   std::size_t free_count = 0, constrained = 0;
@@ -366,14 +368,11 @@ TEST(Editor, AHandleWithoutABaseVertexOfItsOwnIsRefused) {
   Editor editor(mesh, options);
   const EditorPartsView parts = editor.parts();
   const auto support = sphere_ids(mesh, Vec3(0, 0, 1), 0.9);
-  const auto nearest = [](const std::array<double, 3>& b) {
-    return b[0] >= b[1] && b[0] >= b[2] ? 0 : b[1] >= b[2] ? 1 : 2;
-  };
   // The input vertices that are the nearest corner of some base vertex's location.
   std::vector<char> someones_corner(mesh.n_vertices(), 0);
   for (const SurfacePoint& sp : parts.base_on_input)
     someones_corner[static_cast<std::size_t>(parts.input_topology.faces[static_cast<std::size_t>(
-        sp.face.idx())][static_cast<std::size_t>(nearest(sp.bary))])] = 1;
+        sp.face.idx())][static_cast<std::size_t>(nearest_corner(sp.bary))])] = 1;
   // Two support vertices whose nearest base vertex is the same one, the second no base vertex's
   // nearest corner.
   std::map<int, int> first_at;
@@ -382,7 +381,7 @@ TEST(Editor, AHandleWithoutABaseVertexOfItsOwnIsRefused) {
     if (someones_corner[static_cast<std::size_t>(v)]) continue;
     const SurfacePoint& sp = parts.input_on_base[static_cast<std::size_t>(v)];
     const int w = parts.topology.faces[static_cast<std::size_t>(sp.face.idx())]
-                                      [static_cast<std::size_t>(nearest(sp.bary))];
+                                      [static_cast<std::size_t>(nearest_corner(sp.bary))];
     const auto [at, added] = first_at.emplace(w, v);
     if (!added) {
       handles = {{at->second}, {v}};

@@ -29,20 +29,20 @@ bool keep_freed_memory() {
 #endif
 }
 
+std::uint64_t minor_page_faults() {
+  rusage u{};
+  return getrusage(RUSAGE_SELF, &u) == 0 ? static_cast<std::uint64_t>(u.ru_minflt) : 0;
+}
+
 std::uint64_t warm_heap(std::size_t bytes) {
-  const auto faults = [] {
-    rusage u{};
-    getrusage(RUSAGE_SELF, &u);
-    return static_cast<std::uint64_t>(u.ru_minflt);
-  };
-  const std::uint64_t before = faults();
+  const std::uint64_t before = minor_page_faults();
   auto* block = static_cast<volatile char*>(std::malloc(bytes));
   if (block == nullptr) return 0;
   const auto page =
       static_cast<std::size_t>(sysconf(_SC_PAGESIZE) > 0 ? sysconf(_SC_PAGESIZE) : 4096);
   for (std::size_t i = 0; i < bytes; i += page) block[i] = 0;
   std::free(const_cast<char*>(block));
-  return faults() - before;
+  return minor_page_faults() - before;
 }
 
 } // namespace remora

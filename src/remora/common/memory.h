@@ -30,4 +30,7 @@ bool keep_freed_memory();
 /// fails.
 std::uint64_t warm_heap(std::size_t bytes);
 
+/// The process's minor page faults so far (getrusage), 0 where it cannot be told.
+std::uint64_t minor_page_faults();
+
 } // namespace remora

@@ -122,13 +122,14 @@ void Editor::Impl::map_to_base(RegionState& r) const {
   for (std::size_t v = 0; v < nb; ++v)
     if (r.base_label[v] >= 0)
       r.handle_base[static_cast<std::size_t>(r.base_label[v])].push_back(static_cast<int>(v));
-  // A handle whose every base vertex went to a handle of lower index would move nothing.
+  // A handle without a base vertex (each went to a handle of lower index, or its vertices lie on
+  // no face of the base) would move nothing.
   for (int j = 0; j < r.handles; ++j)
     if (r.handle_base[static_cast<std::size_t>(j)].empty())
       throw InvalidArgument(fmt::format(
           "handle {} has no vertex of its own on the base (edge length {:.4g}): its vertices are "
-          "nearest to base vertices of a handle of lower index; paint it wider or farther from "
-          "the other handles",
+          "nearest to base vertices of a handle of lower index, or on no face; paint it wider or "
+          "farther from the other handles",
           j, report.base_target_length));
 }
 
