@@ -19,6 +19,7 @@
 #include "remora/common/error.h"
 #include "remora/common/parallel.h"
 #include "remora/linalg/blas_threads.h"
+#include "remora/linalg/split_cholesky.h"
 
 extern "C" {
 // LAPACK (OpenBLAS): Cholesky factorization and solve of a symmetric positive definite band matrix.
@@ -110,7 +111,8 @@ struct ExposedCholmod : Eigen::CholmodSupernodalLLT<Sparse, Eigen::Lower> {
 
 class CholmodSolver final : public Solver {
 public:
-  explicit CholmodSolver(bool metis) : metis_(metis) {
+  CholmodSolver(bool metis, int threads)
+      : metis_(metis), threads_(threads > 0 ? threads : omp_get_max_threads()) {
     cholmod_common& c = llt_.cholmod();
     c.nmethods = 1;
     c.method[0].ordering = metis ? CHOLMOD_METIS : CHOLMOD_AMD;
@@ -121,12 +123,29 @@ public:
   bool needs_spd() const override { return true; }
   void analyze(const Sparse& a) override {
     require_square(a, "cholmod");
+    n_ = a.rows();
+    split_.reset();
+    if (!metis_ && threads_ >= 2 && n_ >= kSplitRows && n_ <= kCoarseSupernodesRows &&
+        a.isCompressed()) {
+      auto split = std::make_unique<SplitCholesky>();
+      if (split->analyze(a, kMaxSeparatorRows)) {
+        split_ = std::move(split);
+        return;
+      }
+    }
     coarse_supernodes(a.rows() <= kCoarseSupernodesRows);
     llt_.analyzePattern(a);
-    n_ = a.rows();
   }
   void factorize(const Sparse& a) override {
     require_finite(a, "cholmod");
+    if (split_) {
+      const BlasThreadsScope one_blas_thread; // a core for each half
+      if (!split_->factorize(a)) throw NumericalError(not_spd("cholmod"));
+      stats_.factor_nonzeros = split_->factor_nonzeros();
+      stats_.factor_bytes = split_->factor_bytes();
+      stats_.separator_rows = split_->separator_rows();
+      return;
+    }
     // The analysis's flop count: a small factor runs the BLAS on one thread (blas_threads.h).
     small_ = llt_.cholmod().fl < kThreadedBlasFlops;
     std::optional<BlasThreadsScope> one_blas_thread;
@@ -142,6 +161,7 @@ public:
     if (llt_.info() != Eigen::Success || l == nullptr || l->minor < l->n)
       throw NumericalError(not_spd("cholmod"));
     stats_.factor_nonzeros = l->xsize;
+    stats_.separator_rows = 0;
     stats_.factor_bytes = l->xsize * sizeof(double) + l->ssize * sizeof(SuiteSparse_long) +
                           static_cast<std::size_t>(l->n) * 4 * sizeof(SuiteSparse_long);
   }
@@ -149,6 +169,10 @@ public:
   // handle move, and each call then allocates nothing (Eigen's wrapper allocates and copies).
   Eigen::MatrixXd solve(const Eigen::MatrixXd& b, const Eigen::MatrixXd*) override {
     require_rhs(n_, b, "cholmod");
+    if (split_) {
+      const BlasThreadsScope one_blas_thread;
+      return split_->solve(b);
+    }
     cholmod_factor* l = const_cast<cholmod_factor*>(llt_.factor());
     if (l == nullptr) throw InvalidArgument("cholmod: solve() before factorize()");
     cholmod_dense rhs{};
@@ -195,7 +219,14 @@ private:
   // is faster, and the editor's threads after it are not slowed; at 9.1 GFlop (igea_sub4's 119k)
   // two threads factor 15 % faster (docs/solvers.md).
   static constexpr double kThreadedBlasFlops = 4e9;
+  // Systems of kSplitRows to kCoarseSupernodesRows rows are factored in two halves on two threads
+  // when a separator of at most kMaxSeparatorRows rows balances them (split_cholesky.h): its
+  // dense Schur complement then costs a few milliseconds (docs/solvers.md).
+  static constexpr Eigen::Index kSplitRows = 8000;
+  static constexpr int kMaxSeparatorRows = 1500;
   bool metis_;
+  int threads_;
+  std::unique_ptr<SplitCholesky> split_;
   bool small_ = true;
   ExposedCholmod llt_;
   Eigen::Index n_ = 0;
@@ -516,6 +547,7 @@ std::unique_ptr<Solver> make_solver(const SolverOptions& options) {
   if (!(options.tolerance > 0) || !std::isfinite(options.tolerance))
     throw InvalidArgument("solver tolerance must be positive and finite");
   if (options.max_iterations < 0) throw InvalidArgument("solver max_iterations must be >= 0");
+  if (options.threads < 0) throw InvalidArgument("solver threads must be >= 0 (0 = all)");
   using AmdLdlt = Eigen::SimplicialLDLT<Sparse, Eigen::Lower, Eigen::AMDOrdering<int>>;
   using AmdLlt = Eigen::SimplicialLLT<Sparse, Eigen::Lower, Eigen::AMDOrdering<int>>;
   if (name == "ldlt") return std::make_unique<SimplicialSolver<AmdLdlt>>("ldlt");
@@ -539,7 +571,8 @@ std::unique_ptr<Solver> make_solver(const SolverOptions& options) {
         IterativeSolver<Eigen::BiCGSTAB<Sparse, Eigen::DiagonalPreconditioner<double>>>>(
         "bicgstab", false, options);
 #ifdef REMORA_WITH_GPL_SOLVERS
-  if (name == "cholmod") return std::make_unique<CholmodSolver>(options.ordering == "metis");
+  if (name == "cholmod")
+    return std::make_unique<CholmodSolver>(options.ordering == "metis", options.threads);
   if (name == "lu") return std::make_unique<LuSolver<Eigen::UmfPackLU<Sparse>>>();
 #else
   if (name == "lu")

@@ -5,7 +5,9 @@
 //
 //   name        matrix       method
 //   cholmod     SPD          CHOLMOD supernodal Cholesky, AMD or METIS ordering (GPL module;
-//                            only when built with REMORA_WITH_GPL_SOLVERS, then the default)
+//                            only when built with REMORA_WITH_GPL_SOLVERS, then the default);
+//                            with AMD, two threads and 8,000-200,000 rows, two halves around a
+//                            separator on two threads (split_cholesky.h)
 //   ldlt        SPD          Eigen SimplicialLDLT, AMD ordering (the permissive default)
 //   llt         SPD          Eigen SimplicialLLT, AMD ordering (what libigl's
 //                            min_quad_with_fixed uses; kept as the yardstick)
@@ -38,6 +40,9 @@ struct SolverOptions {
   /// banded: refuse when the band storage would exceed this many bytes (the band of a large
   /// surface mesh grows like sqrt(n), its storage like n^1.5).
   std::size_t max_band_bytes = std::size_t(4) << 30;
+  /// cholmod (amd): with 2 threads or more, a system of 8,000 to 200,000 rows is factored as two
+  /// halves around a separator, one per thread (split_cholesky.h); 1 = one factor on one thread.
+  int threads = 0; ///< 0 = all hardware threads
 };
 
 struct SolverStats {
@@ -45,7 +50,8 @@ struct SolverStats {
   double residual = 0.0;        ///< iterative: the largest relative residual of the last solve
   std::size_t factor_bytes = 0; ///< direct: memory of the factor (values and indices)
   std::size_t factor_nonzeros = 0;
-  int bandwidth = 0; ///< banded: half-bandwidth after the ordering
+  int bandwidth = 0;      ///< banded: half-bandwidth after the ordering
+  int separator_rows = 0; ///< cholmod: the separator's rows when factored in two halves, else 0
 };
 
 class Solver {

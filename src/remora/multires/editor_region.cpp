@@ -243,6 +243,7 @@ void Editor::Impl::solve_basis(RegionState& r, EditReport& out, const std::stop_
       t0 = Clock::now();
       SolverOptions so = options.solver;
       so.name = name;
+      if (so.threads == 0) so.threads = options.threads;
       const std::unique_ptr<Solver> solver = make_solver(so);
       if (stop.stop_requested()) return;
       solver->compute(system.matrix);

@@ -349,6 +349,7 @@ void NonlinearDeformer::Impl::build(const Mesh& base, const Eigen::MatrixXd& res
   k.makeCompressed();
   SolverOptions so = options.solver;
   if (so.name.empty()) so.name = default_solver_name();
+  if (so.threads == 0) so.threads = options.threads;
   solver = make_solver(so);
   solver->compute(k);
 

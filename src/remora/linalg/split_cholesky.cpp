@@ -1,0 +1,475 @@
+#include "remora/linalg/split_cholesky.h"
+
+#include <algorithm>
+#include <exception>
+
+#include "remora/common/error.h"
+#include "remora/common/parallel.h"
+
+#ifdef REMORA_WITH_GPL_SOLVERS
+#include <cholmod.h>
+
+extern "C" { // BLAS and LAPACK (OpenBLAS, whose kernels use the machine's vector width)
+void dtrmm_(const char* side, const char* uplo, const char* transa, const char* diag, const int* m,
+            const int* n, const double* alpha, const double* a, const int* lda, double* b,
+            const int* ldb);
+void dpotrf_(const char* uplo, const int* n, double* a, const int* lda, int* info);
+void dpotrs_(const char* uplo, const int* n, const int* nrhs, const double* a, const int* lda,
+             double* b, const int* ldb, int* info);
+}
+#endif
+
+namespace remora {
+
+namespace {
+
+using Sparse = Eigen::SparseMatrix<double>;
+
+// The graph of a symmetric pattern (lower triangle of `a`), without its diagonal, as CSR.
+struct Graph {
+  std::vector<int> begin, next;
+};
+
+Graph adjacency(const Sparse& a) {
+  const int n = static_cast<int>(a.rows());
+  std::vector<int> degree(static_cast<std::size_t>(n), 0);
+  for (int j = 0; j < a.outerSize(); ++j)
+    for (Sparse::InnerIterator it(a, j); it; ++it)
+      if (it.row() > j) {
+        ++degree[static_cast<std::size_t>(it.row())];
+        ++degree[static_cast<std::size_t>(j)];
+      }
+  Graph g;
+  g.begin.assign(static_cast<std::size_t>(n) + 1, 0);
+  for (int i = 0; i < n; ++i) g.begin[i + 1] = g.begin[i] + degree[i];
+  g.next.resize(static_cast<std::size_t>(g.begin[n]));
+  std::vector<int> fill(g.begin.begin(), g.begin.end() - 1);
+  for (int j = 0; j < a.outerSize(); ++j)
+    for (Sparse::InnerIterator it(a, j); it; ++it)
+      if (const int r = static_cast<int>(it.row()); r > j) {
+        g.next[static_cast<std::size_t>(fill[r]++)] = j;
+        g.next[static_cast<std::size_t>(fill[j]++)] = r;
+      }
+  return g;
+}
+
+// Breadth-first levels from `start` (-1: not reached); returns how many rows were reached and
+// sets `last` to the last one reached (one of the farthest).
+int bfs_levels(const Graph& g, int start, std::vector<int>& level, int& last) {
+  std::fill(level.begin(), level.end(), -1);
+  std::vector<int> queue;
+  queue.reserve(level.size());
+  queue.push_back(start);
+  level[static_cast<std::size_t>(start)] = 0;
+  for (std::size_t head = 0; head < queue.size(); ++head) {
+    const int v = queue[head];
+    for (int k = g.begin[v]; k < g.begin[v + 1]; ++k)
+      if (const int w = g.next[static_cast<std::size_t>(k)]; level[w] < 0) {
+        level[w] = level[v] + 1;
+        queue.push_back(w);
+      }
+  }
+  last = queue.back();
+  return static_cast<int>(queue.size());
+}
+
+} // namespace
+
+LevelSeparator level_separator(const Sparse& a) {
+  const int n = static_cast<int>(a.rows());
+  if (n < 3 || a.cols() != a.rows()) return {};
+  const Graph g = adjacency(a);
+  // The largest connected component is split by a level; the others join one half whole.
+  std::vector<int> level(static_cast<std::size_t>(n), -1), queue;
+  std::vector<char> seen(level.size(), 0);
+  int largest = -1, largest_size = 0, last = 0;
+  for (int v = 0; v < n; ++v) {
+    if (seen[static_cast<std::size_t>(v)]) continue;
+    queue.assign(1, v);
+    seen[static_cast<std::size_t>(v)] = 1;
+    for (std::size_t head = 0; head < queue.size(); ++head)
+      for (int k = g.begin[queue[head]]; k < g.begin[queue[head] + 1]; ++k)
+        if (const int w = g.next[static_cast<std::size_t>(k)]; !seen[static_cast<std::size_t>(w)]) {
+          seen[static_cast<std::size_t>(w)] = 1;
+          queue.push_back(w);
+        }
+    if (static_cast<int>(queue.size()) > largest_size) {
+      largest_size = static_cast<int>(queue.size());
+      largest = v;
+    }
+  }
+  bfs_levels(g, largest, level, last);
+  bfs_levels(g, last, level, last);  // from a pseudo-peripheral row: thin, balanced levels
+  const int rest = n - largest_size; // rows of the other components
+  const int depth = level[static_cast<std::size_t>(last)] + 1;
+  std::vector<int> count(static_cast<std::size_t>(depth), 0);
+  for (const int l : level)
+    if (l >= 0) ++count[static_cast<std::size_t>(l)];
+  int best = -1, rest_side = 1;
+  for (int m = 1, below = count[0]; m + 1 < depth; below += count[m], ++m) {
+    const int above = largest_size - below - count[m];
+    for (int side = 0; side < 2; ++side) {
+      const int halves[2] = {below + (side == 0 ? rest : 0), above + (side == 1 ? rest : 0)};
+      if (std::min(halves[0], halves[1]) < 0.4 * (halves[0] + halves[1])) continue;
+      if (best < 0 || count[m] < count[best]) {
+        best = m;
+        rest_side = side;
+      }
+    }
+  }
+  if (best < 0) return {};
+  LevelSeparator s;
+  s.part.resize(static_cast<std::size_t>(n));
+  for (int v = 0; v < n; ++v) {
+    const int l = level[static_cast<std::size_t>(v)];
+    const unsigned char p = l < 0      ? static_cast<unsigned char>(rest_side)
+                            : l < best ? 0
+                            : l > best ? 1
+                                       : 2;
+    s.part[static_cast<std::size_t>(v)] = p;
+    if (p == 2)
+      ++s.separator_rows;
+    else
+      ++s.rows[p];
+  }
+  return s;
+}
+
+#ifdef REMORA_WITH_GPL_SOLVERS
+
+namespace {
+
+// Runs body(0) and body(1) on two threads (CHOLMOD's own OpenMP regions nested in them run on
+// one thread), and rethrows what either threw.
+template <class Body>
+void on_both_halves(Body&& body) {
+  std::exception_ptr error[2];
+  parallel_blocks(2, 2, [&](std::size_t i) {
+    try {
+      body(static_cast<int>(i));
+    } catch (...) {
+      error[i] = std::current_exception();
+    }
+  });
+  for (const auto& e : error)
+    if (e) std::rethrow_exception(e);
+}
+
+cholmod_dense dense_view(Eigen::MatrixXd& m) {
+  cholmod_dense d{};
+  d.nrow = d.d = static_cast<std::size_t>(m.rows());
+  d.ncol = static_cast<std::size_t>(m.cols());
+  d.nzmax = d.nrow * d.ncol;
+  d.x = m.data();
+  d.xtype = CHOLMOD_REAL;
+  d.dtype = CHOLMOD_DOUBLE;
+  return d;
+}
+
+// b = l b or lᵀ b (transpose 'T'), l lower triangular, b a column-major block of leading
+// dimension ld.
+void lower_times(const Eigen::MatrixXd& l, char transpose, double* b, int columns, int ld) {
+  const int s = static_cast<int>(l.rows());
+  const double one = 1.0;
+  if (s > 0 && columns > 0)
+    dtrmm_("L", "L", &transpose, "N", &s, &columns, &one, l.data(), &s, b, &ld);
+}
+
+Eigen::Map<Eigen::MatrixXd> as_matrix(cholmod_dense* d) {
+  return {static_cast<double*>(d->x), static_cast<Eigen::Index>(d->nrow),
+          static_cast<Eigen::Index>(d->ncol)};
+}
+
+// One half bordered by the separator: local rows 0..n−1 are the half's, n..n+s−1 the separator's.
+struct Half {
+  cholmod_common c{};
+  cholmod_factor* factor = nullptr;
+  std::vector<int> rows; // the global row of each local row of the half
+  int n = 0;
+  std::vector<int> colptr, rowind; // lower triangle of the bordered matrix, CSC
+  std::vector<double> values;
+  std::vector<Eigen::Index> source; // each value's index in the global matrix's values
+  std::vector<int> order;           // the separator row at each of the factor's trailing rows
+  Eigen::MatrixXd lss;              // the factor's trailing s × s block (lower triangular)
+  Eigen::MatrixXd product; // lss lssᵀ = K_SS − C_iᵀ A_i⁻¹ C_i, in the factor's order
+  Eigen::MatrixXd rhs, t;  // a solve's bordered right-hand side, and lss × its tail
+  cholmod_dense *xa = nullptr, *xb = nullptr, *y = nullptr, *e = nullptr;
+
+  Half() { cholmod_start(&c); }
+  ~Half() {
+    cholmod_free_factor(&factor, &c);
+    for (cholmod_dense** d : {&xa, &xb, &y, &e}) cholmod_free_dense(d, &c);
+    cholmod_finish(&c);
+  }
+  Half(const Half&) = delete;
+  Half& operator=(const Half&) = delete;
+
+  int size() const { return static_cast<int>(colptr.size()) - 1; }
+  int separator_rows() const { return size() - n; }
+
+  cholmod_sparse view() {
+    cholmod_sparse m{};
+    m.nrow = m.ncol = static_cast<std::size_t>(size());
+    m.nzmax = rowind.size();
+    m.p = colptr.data();
+    m.i = rowind.data();
+    m.x = values.data();
+    m.stype = -1;
+    m.itype = CHOLMOD_INT;
+    m.xtype = CHOLMOD_REAL;
+    m.dtype = CHOLMOD_DOUBLE;
+    m.sorted = 1;
+    m.packed = 1;
+    return m;
+  }
+
+  // CAMD with the separator last, then CHOLMOD's supernodal analysis of exactly that order (no
+  // postorder: it may move a row of the half behind the separator's). False if a row of the half
+  // still ended among the trailing rows.
+  bool analyze() {
+    cholmod_sparse m = view();
+    std::vector<int> member(static_cast<std::size_t>(size()), 1);
+    std::fill(member.begin(), member.begin() + n, 0);
+    std::vector<int> perm(static_cast<std::size_t>(size()));
+    if (!cholmod_camd(&m, nullptr, 0, member.data(), perm.data(), &c))
+      throw NumericalError("cholmod: the constrained ordering failed (out of memory?)");
+    c.nmethods = 1;
+    c.method[0].ordering = CHOLMOD_GIVEN;
+    c.postorder = 0;
+    c.print = 0;
+    c.supernodal = CHOLMOD_SUPERNODAL;
+    const int nrelax[3] = {16, 64, 256};
+    const double zrelax[3] = {0.9, 0.3, 0.1};
+    for (int i = 0; i < 3; ++i) {
+      c.nrelax[i] = static_cast<std::size_t>(nrelax[i]);
+      c.zrelax[i] = zrelax[i];
+    }
+    factor = cholmod_analyze_p(&m, perm.data(), nullptr, 0, &c);
+    if (factor == nullptr)
+      throw NumericalError("cholmod: the symbolic analysis failed (out of memory?)");
+    const int* p = static_cast<const int*>(factor->Perm);
+    order.resize(static_cast<std::size_t>(separator_rows()));
+    for (int k = n; k < size(); ++k) {
+      if (p[k] < n) return false;
+      order[static_cast<std::size_t>(k - n)] = p[k] - n;
+    }
+    return true;
+  }
+
+  // The numbers, the factor, and its trailing block and that block's product with itself.
+  // False when the half is not positive definite.
+  bool factorize(const double* global_values) {
+    for (std::size_t k = 0; k < values.size(); ++k) values[k] = global_values[source[k]];
+    cholmod_sparse m = view();
+    const int done = cholmod_factorize(&m, factor, &c);
+    if (c.status == CHOLMOD_NOT_POSDEF || (done && factor->minor < factor->n)) return false;
+    if (!done) throw NumericalError("cholmod: the factorization failed (out of memory?)");
+    const int s = separator_rows();
+    lss.setZero(s, s);
+    const auto* super = static_cast<const int*>(factor->super);
+    const auto* pi = static_cast<const int*>(factor->pi);
+    const auto* px = static_cast<const int*>(factor->px);
+    const auto* srow = static_cast<const int*>(factor->s);
+    const auto* x = static_cast<const double*>(factor->x);
+    for (std::size_t k = 0; k < factor->nsuper; ++k) {
+      const int rows_of_node = pi[k + 1] - pi[k];
+      for (int j = std::max(super[k], n); j < super[k + 1]; ++j)
+        for (int r = j - super[k]; r < rows_of_node; ++r)
+          lss(srow[pi[k] + r] - n, j - n) = x[px[k] + (j - super[k]) * rows_of_node + r];
+    }
+    product = lss.transpose();
+    lower_times(lss, 'N', product.data(), s, s);
+    return true;
+  }
+
+  void sweep(int system, cholmod_dense* in, cholmod_dense** out) {
+    if (!cholmod_solve2(system, factor, in, nullptr, out, nullptr, &y, &e, &c) || *out == nullptr)
+      throw NumericalError("cholmod: the solve failed (out of memory?)");
+  }
+
+  // Forward: xb = L⁻¹ P [b_i; 0]; t = lss × its trailing rows = −C_iᵀ A_i⁻¹ b_i.
+  void forward(const Eigen::MatrixXd& b) {
+    rhs.setZero(size(), b.cols());
+    for (int l = 0; l < n; ++l) rhs.row(l) = b.row(rows[static_cast<std::size_t>(l)]);
+    cholmod_dense in = dense_view(rhs);
+    sweep(CHOLMOD_P, &in, &xa);
+    sweep(CHOLMOD_L, xa, &xb);
+    t = as_matrix(xb).bottomRows(separator_rows());
+    lower_times(lss, 'N', t.data(), static_cast<int>(t.cols()), static_cast<int>(t.rows()));
+  }
+
+  // Backward, with the separator's values xs (in separator order): the half's rows of x.
+  void backward(const Eigen::MatrixXd& xs, Eigen::MatrixXd& x) {
+    const int s = separator_rows();
+    Eigen::MatrixXd ordered(s, xs.cols());
+    for (int a = 0; a < s; ++a) ordered.row(a) = xs.row(order[static_cast<std::size_t>(a)]);
+    lower_times(lss, 'T', ordered.data(), static_cast<int>(ordered.cols()), s);
+    as_matrix(xb).bottomRows(s) = ordered;
+    sweep(CHOLMOD_Lt, xb, &xa);
+    sweep(CHOLMOD_Pt, xa, &xb);
+    const auto solved = as_matrix(xb);
+    for (int l = 0; l < n; ++l) x.row(rows[static_cast<std::size_t>(l)]) = solved.row(l);
+  }
+};
+
+} // namespace
+
+struct SplitCholesky::Impl {
+  Half half[2];
+  std::vector<int> separator; // global rows of the separator
+  struct Entry {
+    int row, col;
+    Eigen::Index source;
+  };
+  std::vector<Entry> separator_entries; // K_SS's lower triangle, in separator rows
+  Eigen::Index n = 0, nonzeros = 0;
+  Eigen::MatrixXd schur; // the Schur complement's Cholesky factor (lower triangle)
+
+  // The bordered matrix of half i: its pattern and where each value comes from.
+  void build_half(const Sparse& a, const std::vector<int>& local, int i) {
+    Half& h = half[i];
+    const int size = h.n + static_cast<int>(separator.size());
+    // Entries (row ≥ col, local) counted per column, placed, then sorted within each column.
+    std::vector<std::pair<int, int>> entries; // (local row, local column) of each used entry
+    std::vector<Eigen::Index> sources;
+    for (int j = 0; j < a.outerSize(); ++j)
+      for (Sparse::InnerIterator it(a, j); it; ++it) {
+        if (it.row() < j) continue;
+        const int lr = local[static_cast<std::size_t>(2 * it.row() + i)];
+        const int lc = local[static_cast<std::size_t>(2 * j + i)];
+        if (lr < 0 || lc < 0) continue;
+        entries.emplace_back(std::max(lr, lc), std::min(lr, lc));
+        sources.push_back(&it.valueRef() - a.valuePtr());
+      }
+    h.colptr.assign(static_cast<std::size_t>(size) + 1, 0);
+    for (const auto& e : entries) ++h.colptr[static_cast<std::size_t>(e.second) + 1];
+    for (int j = 0; j < size; ++j) h.colptr[j + 1] += h.colptr[j];
+    std::vector<std::pair<int, Eigen::Index>> placed(entries.size());
+    std::vector<int> next(h.colptr.begin(), h.colptr.end() - 1);
+    for (std::size_t k = 0; k < entries.size(); ++k)
+      placed[static_cast<std::size_t>(next[entries[k].second]++)] = {entries[k].first, sources[k]};
+    for (int j = 0; j < size; ++j)
+      std::sort(placed.begin() + h.colptr[j], placed.begin() + h.colptr[j + 1]);
+    h.rowind.resize(placed.size());
+    h.source.resize(placed.size());
+    h.values.assign(placed.size(), 0.0);
+    for (std::size_t k = 0; k < placed.size(); ++k) {
+      h.rowind[k] = placed[k].first;
+      h.source[k] = placed[k].second;
+    }
+  }
+};
+
+SplitCholesky::SplitCholesky() : impl_(std::make_unique<Impl>()) {}
+SplitCholesky::~SplitCholesky() = default;
+
+bool SplitCholesky::analyze(const Sparse& a, int max_separator_rows) {
+  impl_ = std::make_unique<Impl>();
+  Impl& m = *impl_;
+  if (!a.isCompressed()) return false;
+  const LevelSeparator split = level_separator(a);
+  if (split.part.empty() || split.separator_rows > max_separator_rows) return false;
+  m.n = a.rows();
+  m.nonzeros = a.nonZeros();
+  // local[2v + i]: row v's local row in half i (-1: not in it)
+  std::vector<int> local(static_cast<std::size_t>(2 * m.n), -1);
+  for (int v = 0; v < m.n; ++v) {
+    const int p = split.part[static_cast<std::size_t>(v)];
+    if (p == 2) continue;
+    Half& h = m.half[p];
+    local[static_cast<std::size_t>(2 * v + p)] = h.n++;
+    h.rows.push_back(v);
+  }
+  for (int v = 0; v < m.n; ++v)
+    if (split.part[static_cast<std::size_t>(v)] == 2) {
+      const int s = static_cast<int>(m.separator.size());
+      for (int i = 0; i < 2; ++i) local[static_cast<std::size_t>(2 * v + i)] = m.half[i].n + s;
+      m.separator.push_back(v);
+    }
+  for (int j = 0; j < a.outerSize(); ++j)
+    for (Sparse::InnerIterator it(a, j); it; ++it)
+      if (it.row() >= j && split.part[static_cast<std::size_t>(it.row())] == 2 &&
+          split.part[static_cast<std::size_t>(j)] == 2)
+        m.separator_entries.push_back({local[static_cast<std::size_t>(2 * it.row())] - m.half[0].n,
+                                       local[static_cast<std::size_t>(2 * j)] - m.half[0].n,
+                                       &it.valueRef() - a.valuePtr()});
+  bool ordered[2] = {false, false};
+  on_both_halves([&](int i) {
+    m.build_half(a, local, i);
+    ordered[i] = m.half[i].analyze();
+  });
+  if (!ordered[0] || !ordered[1]) {
+    impl_ = std::make_unique<Impl>();
+    return false;
+  }
+  return true;
+}
+
+bool SplitCholesky::factorize(const Sparse& a) {
+  Impl& m = *impl_;
+  if (m.half[0].factor == nullptr) throw InvalidArgument("cholmod: factorize() before analyze()");
+  if (a.rows() != m.n || a.nonZeros() != m.nonzeros || !a.isCompressed())
+    throw InvalidArgument("cholmod: factorize() needs the pattern given to analyze()");
+  bool definite[2] = {false, false};
+  on_both_halves([&](int i) { definite[i] = m.half[i].factorize(a.valuePtr()); });
+  if (!definite[0] || !definite[1]) return false;
+  // K_SS − Σ C_iᵀ A_i⁻¹ C_i = Σ lss_i lss_iᵀ − K_SS, in separator order.
+  const int s = static_cast<int>(m.separator.size());
+  Eigen::MatrixXd& schur = m.schur;
+  schur.setZero(s, s);
+  for (const Half& h : m.half)
+    for (int b = 0; b < s; ++b)
+      for (int r = 0; r < s; ++r)
+        schur(h.order[static_cast<std::size_t>(r)], h.order[static_cast<std::size_t>(b)]) +=
+            h.product(r, b);
+  for (const auto& e : m.separator_entries) {
+    const double v = a.valuePtr()[e.source];
+    schur(e.row, e.col) -= v;
+    if (e.row != e.col) schur(e.col, e.row) -= v;
+  }
+  int info = 0;
+  if (s > 0) dpotrf_("L", &s, schur.data(), &s, &info);
+  return info == 0;
+}
+
+Eigen::MatrixXd SplitCholesky::solve(const Eigen::MatrixXd& b) {
+  Impl& m = *impl_;
+  on_both_halves([&](int i) { m.half[i].forward(b); });
+  const int s = static_cast<int>(m.separator.size());
+  Eigen::MatrixXd xs(s, b.cols());
+  for (int r = 0; r < s; ++r) xs.row(r) = b.row(m.separator[static_cast<std::size_t>(r)]);
+  for (const Half& h : m.half)
+    for (int r = 0; r < s; ++r) xs.row(h.order[static_cast<std::size_t>(r)]) += h.t.row(r);
+  const int columns = static_cast<int>(b.cols());
+  int info = 0;
+  if (s > 0 && columns > 0) dpotrs_("L", &s, &columns, m.schur.data(), &s, xs.data(), &s, &info);
+  Eigen::MatrixXd x(b.rows(), b.cols());
+  on_both_halves([&](int i) { m.half[i].backward(xs, x); });
+  for (int r = 0; r < s; ++r) x.row(m.separator[static_cast<std::size_t>(r)]) = xs.row(r);
+  return x;
+}
+
+std::size_t SplitCholesky::factor_nonzeros() const {
+  std::size_t count = impl_->separator.size() * impl_->separator.size();
+  for (const Half& h : impl_->half)
+    if (h.factor != nullptr) count += h.factor->xsize;
+  return count;
+}
+
+std::size_t SplitCholesky::factor_bytes() const {
+  const std::size_t s = impl_->separator.size();
+  std::size_t bytes = 4 * s * s * sizeof(double); // the Schur factor, two blocks, two products
+  for (const Half& h : impl_->half)
+    if (h.factor != nullptr)
+      bytes += h.factor->xsize * sizeof(double) + h.factor->ssize * sizeof(int) +
+               h.factor->n * 4 * sizeof(int);
+  return bytes;
+}
+
+int SplitCholesky::separator_rows() const {
+  return static_cast<int>(impl_->separator.size());
+}
+
+#endif
+
+} // namespace remora

@@ -1,0 +1,69 @@
+// A sparse Cholesky factorization on two threads: one level of nested dissection around CHOLMOD
+// (paper §5: the editor's k-harmonic systems, factored once per region).
+//
+// A separator S (one level of a breadth-first search of the matrix graph from a pseudo-peripheral
+// row) splits the rows into two halves that do not couple:
+//
+//       [ A₁  0   C₁ ]
+//   K = [ 0   A₂  C₂ ]      each half bordered by S, M_i = [A_i C_i; C_iᵀ K_SS] = L_i L_iᵀ,
+//       [ C₁ᵀ C₂ᵀ K_SS]     is ordered by CAMD with S last and factored by CHOLMOD on its thread.
+//
+// The trailing block of L_i is the factor of K_SS − C_iᵀA_i⁻¹C_i, so the Schur complement of S is
+// L₁L₁ᵀ + L₂L₂ᵀ − K_SS (symmetric positive definite whenever K is), factored densely. A solve is a
+// forward sweep of each half, the dense solve of S, and a backward sweep of each half, the halves
+// on two threads. The result is that of one factorization of K to round-off.
+//
+// SplitCholesky exists only in builds with the GPL solvers (CHOLMOD); level_separator in every
+// build. Not thread-safe: one object per thread.
+#pragma once
+
+#include <cstddef>
+#include <memory>
+#include <vector>
+
+#include <Eigen/Dense>
+#include <Eigen/SparseCore>
+
+namespace remora {
+
+/// The rows of a symmetric pattern split by one level of a breadth-first search: part[i] is 0 or
+/// 1 for the two halves, 2 for the separator. Rows of part 0 and part 1 are never coupled.
+struct LevelSeparator {
+  std::vector<unsigned char> part;
+  int separator_rows = 0;
+  int rows[2] = {0, 0};
+};
+
+/// The separator level whose halves are balanced within [0.4, 0.6] of the rest and which has the
+/// fewest rows, read from the lower triangle of `a` (n × n). Empty `part` when the graph is not
+/// connected or no level balances it.
+LevelSeparator level_separator(const Eigen::SparseMatrix<double>& a);
+
+class SplitCholesky {
+public:
+  SplitCholesky();
+  ~SplitCholesky();
+  SplitCholesky(const SplitCholesky&) = delete;
+  SplitCholesky& operator=(const SplitCholesky&) = delete;
+
+  /// Splits the symmetric pattern of `a` (lower triangle read) and analyses both halves. Returns
+  /// false, keeping nothing, when no separator of at most `max_separator_rows` rows balances the
+  /// graph; the caller then factors `a` as one.
+  bool analyze(const Eigen::SparseMatrix<double>& a, int max_separator_rows);
+  /// The numbers of `a`, which has the pattern given to analyze(). Returns false when `a` is not
+  /// positive definite; throws NumericalError when CHOLMOD fails otherwise (out of memory), and
+  /// InvalidArgument for another pattern.
+  bool factorize(const Eigen::SparseMatrix<double>& a);
+  /// X with A X = B, B of n rows.
+  Eigen::MatrixXd solve(const Eigen::MatrixXd& b);
+
+  std::size_t factor_nonzeros() const;
+  std::size_t factor_bytes() const;
+  int separator_rows() const;
+
+private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+} // namespace remora
