@@ -334,7 +334,7 @@ TEST(SplitCholesky, TwoHalvesSolveAsOneFactorDoes) {
     reference->compute(s.matrix);
     const Eigen::MatrixXd x = reference->solve(b);
     SplitCholesky split;
-    ASSERT_TRUE(split.analyze(s.matrix, 5000));
+    ASSERT_TRUE(split.analyze(s.matrix, 5000, true));
     EXPECT_GT(split.separator_rows(), 0);
     ASSERT_TRUE(split.factorize(s.matrix));
     const Eigen::MatrixXd y = split.solve(b);
@@ -350,8 +350,8 @@ TEST(SplitCholesky, TwoHalvesSolveAsOneFactorDoes) {
 TEST(SplitCholesky, RefusesWhatOneFactorRefuses) {
   const KHarmonicSystem s = sphere_system(2, AreaWeights::Mean, 5);
   SplitCholesky split;
-  EXPECT_FALSE(split.analyze(s.matrix, 1)); // no separator that thin
-  ASSERT_TRUE(split.analyze(s.matrix, 5000));
+  EXPECT_FALSE(split.analyze(s.matrix, 1, true)); // no separator that thin
+  ASSERT_TRUE(split.analyze(s.matrix, 5000, true));
   const SparseMatrix indefinite = -s.matrix;
   EXPECT_FALSE(split.factorize(indefinite));
   SparseMatrix other = s.matrix;

@@ -125,10 +125,9 @@ public:
     require_square(a, "cholmod");
     n_ = a.rows();
     split_.reset();
-    if (!metis_ && threads_ >= 2 && n_ >= kSplitRows && n_ <= kCoarseSupernodesRows &&
-        a.isCompressed()) {
+    if (!metis_ && threads_ >= 2 && n_ >= kSplitRows && a.isCompressed()) {
       auto split = std::make_unique<SplitCholesky>();
-      if (split->analyze(a, kMaxSeparatorRows)) {
+      if (split->analyze(a, kMaxSeparatorRows, n_ <= kCoarseSupernodesRows)) {
         split_ = std::move(split);
         return;
       }
@@ -219,11 +218,11 @@ private:
   // is faster, and the editor's threads after it are not slowed; at 9.1 GFlop (igea_sub4's 119k)
   // two threads factor 15 % faster (docs/solvers.md).
   static constexpr double kThreadedBlasFlops = 4e9;
-  // Systems of kSplitRows to kCoarseSupernodesRows rows are factored in two halves on two threads
-  // when a separator of at most kMaxSeparatorRows rows balances them (split_cholesky.h): its
-  // dense Schur complement then costs a few milliseconds (docs/solvers.md).
+  // Systems of kSplitRows rows or more are factored in two halves on two threads when a separator
+  // of at most kMaxSeparatorRows rows balances them (split_cholesky.h); its dense blocks then
+  // hold at most 3 × 4000² doubles, 384 MB, beside a factor of a few GB (docs/solvers.md).
   static constexpr Eigen::Index kSplitRows = 8000;
-  static constexpr int kMaxSeparatorRows = 1500;
+  static constexpr int kMaxSeparatorRows = 4000;
   bool metis_;
   int threads_;
   std::unique_ptr<SplitCholesky> split_;

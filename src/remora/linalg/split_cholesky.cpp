@@ -191,8 +191,8 @@ struct Half {
   std::vector<Eigen::Index> source; // each value's index in the global matrix's values
   std::vector<int> order;           // the separator row at each of the factor's trailing rows
   Eigen::MatrixXd lss;              // the factor's trailing s × s block (lower triangular)
-  Eigen::MatrixXd product; // lss lssᵀ = K_SS − C_iᵀ A_i⁻¹ C_i, in the factor's order
-  Eigen::MatrixXd rhs, t;  // a solve's bordered right-hand side, and lss × its tail
+  Eigen::MatrixXd product; // lss lssᵀ = K_SS − C_iᵀ A_i⁻¹ C_i (factor's order), until summed
+  Eigen::MatrixXd rhs, t; // a solve's bordered right-hand side, and lss × its tail
   cholmod_dense *xa = nullptr, *xb = nullptr, *y = nullptr, *e = nullptr;
 
   Half() { cholmod_start(&c); }
@@ -226,7 +226,7 @@ struct Half {
   // CAMD with the separator last, then CHOLMOD's supernodal analysis of exactly that order (no
   // postorder: it may move a row of the half behind the separator's). False if a row of the half
   // still ended among the trailing rows.
-  bool analyze() {
+  bool analyze(bool coarse) {
     cholmod_sparse m = view();
     std::vector<int> member(static_cast<std::size_t>(size()), 1);
     std::fill(member.begin(), member.begin() + n, 0);
@@ -238,11 +238,13 @@ struct Half {
     c.postorder = 0;
     c.print = 0;
     c.supernodal = CHOLMOD_SUPERNODAL;
-    const int nrelax[3] = {16, 64, 256};
-    const double zrelax[3] = {0.9, 0.3, 0.1};
-    for (int i = 0; i < 3; ++i) {
-      c.nrelax[i] = static_cast<std::size_t>(nrelax[i]);
-      c.zrelax[i] = zrelax[i];
+    if (coarse) {
+      const int nrelax[3] = {16, 64, 256};
+      const double zrelax[3] = {0.9, 0.3, 0.1};
+      for (int i = 0; i < 3; ++i) {
+        c.nrelax[i] = static_cast<std::size_t>(nrelax[i]);
+        c.zrelax[i] = zrelax[i];
+      }
     }
     factor = cholmod_analyze_p(&m, perm.data(), nullptr, 0, &c);
     if (factor == nullptr)
@@ -363,7 +365,7 @@ struct SplitCholesky::Impl {
 SplitCholesky::SplitCholesky() : impl_(std::make_unique<Impl>()) {}
 SplitCholesky::~SplitCholesky() = default;
 
-bool SplitCholesky::analyze(const Sparse& a, int max_separator_rows) {
+bool SplitCholesky::analyze(const Sparse& a, int max_separator_rows, bool coarse_supernodes) {
   impl_ = std::make_unique<Impl>();
   Impl& m = *impl_;
   if (!a.isCompressed()) return false;
@@ -396,7 +398,7 @@ bool SplitCholesky::analyze(const Sparse& a, int max_separator_rows) {
   bool ordered[2] = {false, false};
   on_both_halves([&](int i) {
     m.build_half(a, local, i);
-    ordered[i] = m.half[i].analyze();
+    ordered[i] = m.half[i].analyze(coarse_supernodes);
   });
   if (!ordered[0] || !ordered[1]) {
     impl_ = std::make_unique<Impl>();
@@ -417,11 +419,13 @@ bool SplitCholesky::factorize(const Sparse& a) {
   const int s = static_cast<int>(m.separator.size());
   Eigen::MatrixXd& schur = m.schur;
   schur.setZero(s, s);
-  for (const Half& h : m.half)
+  for (Half& h : m.half) {
     for (int b = 0; b < s; ++b)
       for (int r = 0; r < s; ++r)
         schur(h.order[static_cast<std::size_t>(r)], h.order[static_cast<std::size_t>(b)]) +=
             h.product(r, b);
+    h.product = Eigen::MatrixXd();
+  }
   for (const auto& e : m.separator_entries) {
     const double v = a.valuePtr()[e.source];
     schur(e.row, e.col) -= v;
@@ -458,7 +462,7 @@ std::size_t SplitCholesky::factor_nonzeros() const {
 
 std::size_t SplitCholesky::factor_bytes() const {
   const std::size_t s = impl_->separator.size();
-  std::size_t bytes = 4 * s * s * sizeof(double); // the Schur factor, two blocks, two products
+  std::size_t bytes = 3 * s * s * sizeof(double); // the Schur factor and the two blocks
   for (const Half& h : impl_->half)
     if (h.factor != nullptr)
       bytes += h.factor->xsize * sizeof(double) + h.factor->ssize * sizeof(int) +

@@ -49,7 +49,8 @@ public:
   /// Splits the symmetric pattern of `a` (lower triangle read) and analyses both halves. Returns
   /// false, keeping nothing, when no separator of at most `max_separator_rows` rows balances the
   /// graph; the caller then factors `a` as one.
-  bool analyze(const Eigen::SparseMatrix<double>& a, int max_separator_rows);
+  bool analyze(const Eigen::SparseMatrix<double>& a, int max_separator_rows,
+               bool coarse_supernodes);
   /// The numbers of `a`, which has the pattern given to analyze(). Returns false when `a` is not
   /// positive definite; throws NumericalError when CHOLMOD fails otherwise (out of memory), and
   /// InvalidArgument for another pattern.
