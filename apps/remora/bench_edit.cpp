@@ -152,7 +152,11 @@ void print_bench_edit(const BenchEditArgs& a, const EditReport& r, const BenchEd
       t.set_region_ms, grouped(r.free_base_vertices), grouped(r.handle_base_vertices.at(0)), a.k,
       r.milliseconds.at("map"), r.milliseconds.at("assemble"), r.milliseconds.at("factor"),
       r.milliseconds.at("solve"), r.milliseconds.at("encode"), grouped(r.phong.encoded),
-      r.milliseconds.at("finish"), r.solver);
+      r.milliseconds.at("finish"),
+      r.solver_stats.separator_rows > 0
+          ? fmt::format("{} in two halves (separator {} rows)", r.solver,
+                        grouped(static_cast<std::size_t>(r.solver_stats.separator_rows)))
+          : r.solver);
   if (!t.later_regions.empty())
     std::cout << fmt::format(
         "set_region, regions 2 to {} (each 1 % larger): median {:.0f} ms (map {:.0f}, assemble "

@@ -112,6 +112,9 @@ void print_edit_report(std::ostream& os, const EditReport& r, double load_ms, do
                       r.solver_stats.residual);
   if (r.solver_stats.factor_bytes > 0)
     os << fmt::format(", factor {:.1f} MB", double(r.solver_stats.factor_bytes) / 1e6);
+  if (r.solver_stats.separator_rows > 0)
+    os << fmt::format(" in two halves around a separator of {} rows",
+                      grouped(static_cast<std::size_t>(r.solver_stats.separator_rows)));
   os << "\n";
   os << fmt::format("details: {} encoded, {} walk steps, {} extrapolated, {} fallbacks\n",
                     grouped(r.phong.encoded), grouped(r.phong.walk_steps),

@@ -127,7 +127,10 @@ public:
     split_.reset();
     if (!metis_ && threads_ >= 2 && n_ >= kSplitRows && a.isCompressed()) {
       auto split = std::make_unique<SplitCholesky>();
-      if (split->analyze(a, kMaxSeparatorRows, n_ <= kCoarseSupernodesRows)) {
+      // The dense blocks hold five s × s doubles at once while factoring: s ≤ √(16 n) keeps them
+      // under 640 bytes per row, a small part of a region's memory estimate (docs/limits.md).
+      const double max_rows = std::min(double(kMaxSeparatorRows), std::sqrt(16.0 * double(n_)));
+      if (split->analyze(a, static_cast<int>(max_rows), n_ <= kCoarseSupernodesRows)) {
         split_ = std::move(split);
         return;
       }
@@ -219,10 +222,9 @@ private:
   // two threads factor 15 % faster (docs/solvers.md).
   static constexpr double kThreadedBlasFlops = 4e9;
   // Systems of kSplitRows rows or more are factored in two halves on two threads when a separator
-  // of at most kMaxSeparatorRows rows balances them (split_cholesky.h); its dense blocks then
-  // hold at most 3 × 4000² doubles, 384 MB, beside a factor of a few GB (docs/solvers.md).
+  // of at most kMaxSeparatorRows rows balances them (split_cholesky.h, docs/solvers.md).
   static constexpr Eigen::Index kSplitRows = 8000;
-  static constexpr int kMaxSeparatorRows = 4000;
+  static constexpr int kMaxSeparatorRows = 3000;
   bool metis_;
   int threads_;
   std::unique_ptr<SplitCholesky> split_;

@@ -390,7 +390,8 @@ nlohmann::json to_json(const EditReport& r) {
                  {"solves", r.solves},
                  {"iterations", r.solver_stats.iterations},
                  {"residual", r.solver_stats.residual},
-                 {"factor_bytes", r.solver_stats.factor_bytes}};
+                 {"factor_bytes", r.solver_stats.factor_bytes},
+                 {"separator_rows", r.solver_stats.separator_rows}};
   j["phong"] = {{"encoded", r.phong.encoded},
                 {"walk_steps", r.phong.walk_steps},
                 {"extrapolated", r.phong.extrapolated},
