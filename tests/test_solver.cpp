@@ -333,18 +333,48 @@ TEST(SplitCholesky, TwoHalvesSolveAsOneFactorDoes) {
     auto reference = make_solver({.name = "ldlt"});
     reference->compute(s.matrix);
     const Eigen::MatrixXd x = reference->solve(b);
-    SplitCholesky split;
-    ASSERT_TRUE(split.analyze(s.matrix, 5000, true));
-    EXPECT_GT(split.separator_rows(), 0);
-    ASSERT_TRUE(split.factorize(s.matrix));
-    const Eigen::MatrixXd y = split.solve(b);
-    EXPECT_LE(relative_difference(y, x), 1e-9);
-    EXPECT_LE((s.matrix * y - b).norm() / b.norm(), 1e-10);
-    EXPECT_LE(relative_difference(split.solve(b.col(2)), x.col(2)), 1e-9);
-    const SparseMatrix doubled = 2.0 * s.matrix; // new numbers, same analysis
-    ASSERT_TRUE(split.factorize(doubled));
-    EXPECT_LE(relative_difference(split.solve(b), 0.5 * x), 1e-9);
+    for (const bool coarse : {true, false}) {
+      SCOPED_TRACE(coarse ? "coarse supernodes" : "CHOLMOD's supernodes");
+      SplitCholesky split;
+      ASSERT_TRUE(split.analyze(s.matrix, 5000, coarse));
+      EXPECT_GT(split.separator_rows(), 0);
+      EXPECT_THROW(split.solve(b), InvalidArgument); // not factored yet
+      ASSERT_TRUE(split.factorize(s.matrix));
+      const Eigen::MatrixXd y = split.solve(b);
+      EXPECT_LE(relative_difference(y, x), 1e-9);
+      EXPECT_LE((s.matrix * y - b).norm() / b.norm(), 1e-10);
+      EXPECT_LE(relative_difference(split.solve(b.col(2)), x.col(2)), 1e-9);
+      EXPECT_EQ(split.solve(Eigen::MatrixXd(b.rows(), 0)).cols(), 0);
+      EXPECT_THROW(split.solve(b.topRows(10)), InvalidArgument);
+      const SparseMatrix doubled = 2.0 * s.matrix; // new numbers, same analysis
+      ASSERT_TRUE(split.factorize(doubled));
+      EXPECT_LE(relative_difference(split.solve(b), 0.5 * x), 1e-9);
+    }
   }
+}
+
+// Two components: the small one joins a half whole, and the solve is that of each component.
+TEST(SplitCholesky, ASecondComponentIsSolvedWithItsHalf) {
+  const KHarmonicSystem big = sphere_system(1, AreaWeights::Mean, 5);
+  const KHarmonicSystem small = sphere_system(1, AreaWeights::Mean, 3);
+  const auto n = static_cast<int>(big.matrix.rows());
+  const auto m = static_cast<int>(small.matrix.rows());
+  std::vector<Eigen::Triplet<double>> t;
+  for (int j = 0; j < n; ++j)
+    for (SparseMatrix::InnerIterator it(big.matrix, j); it; ++it)
+      t.emplace_back(static_cast<int>(it.row()), j, it.value());
+  for (int j = 0; j < m; ++j)
+    for (SparseMatrix::InnerIterator it(small.matrix, j); it; ++it)
+      t.emplace_back(static_cast<int>(it.row()) + n, j + n, it.value());
+  SparseMatrix both(n + m, n + m);
+  both.setFromTriplets(t.begin(), t.end());
+  Eigen::MatrixXd b(n + m, 3);
+  b << block_rhs(big), block_rhs(small);
+  SplitCholesky split;
+  ASSERT_TRUE(split.analyze(both, 5000, true));
+  ASSERT_TRUE(split.factorize(both));
+  const Eigen::MatrixXd x = split.solve(b);
+  EXPECT_LE((both * x - b).norm() / b.norm(), 1e-10);
 }
 
 TEST(SplitCholesky, RefusesWhatOneFactorRefuses) {
@@ -359,6 +389,21 @@ TEST(SplitCholesky, RefusesWhatOneFactorRefuses) {
   other.coeffRef(0, 5) += 1.0;
   other.makeCompressed();
   EXPECT_THROW(split.factorize(other), InvalidArgument);
+  // As many entries, in other places: column 0 loses its last entry, column 1 gains one.
+  std::vector<Eigen::Triplet<double>> moved;
+  for (int j = 0; j < s.matrix.outerSize(); ++j)
+    for (SparseMatrix::InnerIterator it(s.matrix, j); it; ++it)
+      moved.emplace_back(static_cast<int>(it.row()), j, it.value());
+  int far = 0; // a row not coupled with row 1
+  while (s.matrix.coeff(far, 1) != 0.0) ++far;
+  const auto last_of_0 = std::find_if(moved.rbegin(), moved.rend(),
+                                      [](const auto& e) { return e.col() == 0 && e.row() != 0; });
+  moved.erase(std::next(last_of_0).base());
+  moved.emplace_back(far, 1, 0.0);
+  SparseMatrix shuffled(s.matrix.rows(), s.matrix.cols());
+  shuffled.setFromTriplets(moved.begin(), moved.end());
+  ASSERT_EQ(shuffled.nonZeros(), s.matrix.nonZeros());
+  EXPECT_THROW(split.factorize(shuffled), InvalidArgument);
 }
 
 // Through make_solver: cholmod factors a large system in two halves when it has two threads, and
@@ -374,6 +419,18 @@ TEST(Solver, CholmodFactorsALargeSystemInTwoHalvesOnTwoThreads) {
   EXPECT_GT(two->stats().separator_rows, 0);
   const Eigen::MatrixXd x = one->solve(b);
   EXPECT_LE((s.matrix * x - b).norm() / b.norm(), 1e-10);
+  EXPECT_LE(relative_difference(two->solve(b), x), 1e-9);
+  EXPECT_EQ(two->solve(Eigen::MatrixXd(b.rows(), 0)).cols(), 0);
+  // The same object analyses a small system (one factor), then the large one again.
+  const KHarmonicSystem small = sphere_system(2, AreaWeights::Mean);
+  two->compute(small.matrix);
+  EXPECT_EQ(two->stats().separator_rows, 0);
+  EXPECT_LE(relative_difference(small.matrix * two->solve(block_rhs(small)), block_rhs(small)),
+            1e-10);
+  two->analyze(s.matrix);
+  EXPECT_THROW(two->solve(b), InvalidArgument); // analysed, not factored
+  two->factorize(s.matrix);
+  EXPECT_GT(two->stats().separator_rows, 0);
   EXPECT_LE(relative_difference(two->solve(b), x), 1e-9);
   const SparseMatrix indefinite = -s.matrix;
   try {

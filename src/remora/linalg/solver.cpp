@@ -112,71 +112,79 @@ struct ExposedCholmod : Eigen::CholmodSupernodalLLT<Sparse, Eigen::Lower> {
 class CholmodSolver final : public Solver {
 public:
   CholmodSolver(bool metis, int threads)
-      : metis_(metis), threads_(threads > 0 ? threads : omp_get_max_threads()) {
-    cholmod_common& c = llt_.cholmod();
-    c.nmethods = 1;
-    c.method[0].ordering = metis ? CHOLMOD_METIS : CHOLMOD_AMD;
-    c.postorder = 1;
-    c.print = 0; // failures are reported by our exception, not on stdout
-  }
+      : metis_(metis), threads_(threads > 0 ? threads : omp_get_max_threads()) {}
   std::string name() const override { return metis_ ? "cholmod (metis)" : "cholmod"; }
   bool needs_spd() const override { return true; }
   void analyze(const Sparse& a) override {
     require_square(a, "cholmod");
+    release();
     n_ = a.rows();
-    split_.reset();
-    if (!metis_ && threads_ >= 2 && n_ >= kSplitRows && a.isCompressed()) {
+    // Two halves on two threads (split_cholesky.h) when both threads are free: not inside an
+    // active OpenMP region, where the halves would run one after the other.
+    if (!metis_ && threads_ >= 2 && omp_get_active_level() == 0 && n_ >= kSplitRows &&
+        a.isCompressed()) {
       auto split = std::make_unique<SplitCholesky>();
       // The dense blocks hold five s × s doubles at once while factoring: s ≤ √(16 n) keeps them
-      // under 640 bytes per row, a small part of a region's memory estimate (docs/limits.md).
+      // under 640 bytes per row (docs/limits.md).
       const double max_rows = std::min(double(kMaxSeparatorRows), std::sqrt(16.0 * double(n_)));
       if (split->analyze(a, static_cast<int>(max_rows), n_ <= kCoarseSupernodesRows)) {
         split_ = std::move(split);
         return;
       }
     }
+    llt_ = std::make_unique<ExposedCholmod>();
+    cholmod_common& c = llt_->cholmod();
+    c.nmethods = 1;
+    c.method[0].ordering = metis_ ? CHOLMOD_METIS : CHOLMOD_AMD;
+    c.postorder = 1;
+    c.print = 0; // failures are reported by our exception, not on stdout
     coarse_supernodes(a.rows() <= kCoarseSupernodesRows);
-    llt_.analyzePattern(a);
+    llt_->analyzePattern(a);
   }
   void factorize(const Sparse& a) override {
     require_finite(a, "cholmod");
+    factored_ = false;
     if (split_) {
       const BlasThreadsScope one_blas_thread; // a core for each half
       if (!split_->factorize(a)) throw NumericalError(not_spd("cholmod"));
       stats_.factor_nonzeros = split_->factor_nonzeros();
       stats_.factor_bytes = split_->factor_bytes();
       stats_.separator_rows = split_->separator_rows();
+      factored_ = true;
       return;
     }
+    if (!llt_) throw InvalidArgument("cholmod: factorize() before analyze()");
     // The analysis's flop count: a small factor runs the BLAS on one thread (blas_threads.h).
-    small_ = llt_.cholmod().fl < kThreadedBlasFlops;
+    small_ = llt_->cholmod().fl < kThreadedBlasFlops;
     std::optional<BlasThreadsScope> one_blas_thread;
     if (small_) one_blas_thread.emplace();
     // CHOLMOD 3 opens an OpenMP region of 4 threads for small loops of every supernode (zeroing,
     // scattering); their wake-ups doubled a small factorization (docs/solvers.md). A large one
     // keeps them, and its BLAS threads.
     if (small_)
-      with_serial_openmp([&] { llt_.factorize(a); });
+      with_serial_openmp([&] { llt_->factorize(a); });
     else
-      llt_.factorize(a);
-    const cholmod_factor* l = llt_.factor();
-    if (llt_.info() != Eigen::Success || l == nullptr || l->minor < l->n)
+      llt_->factorize(a);
+    const cholmod_factor* l = llt_->factor();
+    if (llt_->info() != Eigen::Success || l == nullptr || l->minor < l->n)
       throw NumericalError(not_spd("cholmod"));
     stats_.factor_nonzeros = l->xsize;
     stats_.separator_rows = 0;
     stats_.factor_bytes = l->xsize * sizeof(double) + l->ssize * sizeof(SuiteSparse_long) +
                           static_cast<std::size_t>(l->n) * 4 * sizeof(SuiteSparse_long);
+    factored_ = true;
   }
   // cholmod_solve2 with the solution and workspace kept between calls: a drag solves once per
   // handle move, and each call then allocates nothing (Eigen's wrapper allocates and copies).
   Eigen::MatrixXd solve(const Eigen::MatrixXd& b, const Eigen::MatrixXd*) override {
     require_rhs(n_, b, "cholmod");
+    if (!factored_) throw InvalidArgument("cholmod: solve() before factorize()");
+    if (b.cols() == 0) return Eigen::MatrixXd(n_, 0);
     if (split_) {
       const BlasThreadsScope one_blas_thread;
       return split_->solve(b);
     }
-    cholmod_factor* l = const_cast<cholmod_factor*>(llt_.factor());
-    if (l == nullptr) throw InvalidArgument("cholmod: solve() before factorize()");
+    cholmod_factor* l = const_cast<cholmod_factor*>(llt_->factor());
     cholmod_dense rhs{};
     rhs.nrow = rhs.d = static_cast<std::size_t>(b.rows());
     rhs.ncol = static_cast<std::size_t>(b.cols());
@@ -184,23 +192,31 @@ public:
     rhs.x = const_cast<double*>(b.data());
     rhs.xtype = CHOLMOD_REAL;
     rhs.dtype = CHOLMOD_DOUBLE;
-    cholmod_common& c = llt_.cholmod();
+    cholmod_common& c = llt_->cholmod();
     std::optional<BlasThreadsScope> one_blas_thread;
     if (small_) one_blas_thread.emplace();
     if (!cholmod_solve2(CHOLMOD_A, l, &rhs, nullptr, &x_, nullptr, &y_, &e_, &c) || x_ == nullptr)
       throw NumericalError("cholmod: the solve failed (out of memory?)");
     return Eigen::Map<const Eigen::MatrixXd>(static_cast<const double*>(x_->x), b.rows(), b.cols());
   }
-  ~CholmodSolver() override {
-    cholmod_common& c = llt_.cholmod();
-    cholmod_free_dense(&x_, &c);
-    cholmod_free_dense(&y_, &c);
-    cholmod_free_dense(&e_, &c);
-  }
+  ~CholmodSolver() override { release(); }
   CholmodSolver(const CholmodSolver&) = delete;
   CholmodSolver& operator=(const CholmodSolver&) = delete;
 
 private:
+  // Drops the factor of the last analysis (either kind) and the solve's workspace.
+  void release() {
+    if (llt_) {
+      cholmod_common& c = llt_->cholmod();
+      cholmod_free_dense(&x_, &c);
+      cholmod_free_dense(&y_, &c);
+      cholmod_free_dense(&e_, &c);
+    }
+    llt_.reset();
+    split_.reset();
+    factored_ = false;
+    stats_ = SolverStats{};
+  }
   // Coarser supernodes than CHOLMOD's defaults (4, 16, 48 and 0.8, 0.1, 0.05) for a system of up
   // to kCoarseSupernodesRows rows: a mesh's supernodes are small, and such a factor spends its
   // time between BLAS calls, not in them. Merging more of them stores more explicit zeros, 28 %
@@ -208,7 +224,7 @@ private:
   // region memory estimate of docs/limits.md (docs/solvers.md).
   static constexpr Eigen::Index kCoarseSupernodesRows = 200000;
   void coarse_supernodes(bool coarse) {
-    cholmod_common& c = llt_.cholmod();
+    cholmod_common& c = llt_->cholmod();
     const int nrelax[2][3] = {{4, 16, 48}, {16, 64, 256}};
     const double zrelax[2][3] = {{0.8, 0.1, 0.05}, {0.9, 0.3, 0.1}};
     for (int i = 0; i < 3; ++i) {
@@ -227,9 +243,10 @@ private:
   static constexpr int kMaxSeparatorRows = 3000;
   bool metis_;
   int threads_;
-  std::unique_ptr<SplitCholesky> split_;
+  std::unique_ptr<SplitCholesky> split_; // the two-half factor, or
+  std::unique_ptr<ExposedCholmod> llt_;  // the one factor
+  bool factored_ = false;
   bool small_ = true;
-  ExposedCholmod llt_;
   Eigen::Index n_ = 0;
   cholmod_dense* x_ = nullptr; // solution, reused by cholmod_solve2
   cholmod_dense* y_ = nullptr; // workspace

@@ -1,7 +1,10 @@
 #include "remora/linalg/split_cholesky.h"
 
 #include <algorithm>
+#include <cstdint>
+#include <cstdlib>
 #include <exception>
+#include <string>
 
 #include "remora/common/error.h"
 #include "remora/common/parallel.h"
@@ -14,6 +17,7 @@ void dtrmm_(const char* side, const char* uplo, const char* transa, const char* 
             const int* n, const double* alpha, const double* a, const int* lda, double* b,
             const int* ldb);
 void dpotrf_(const char* uplo, const int* n, double* a, const int* lda, int* info);
+void dlauum_(const char* uplo, const int* n, double* a, const int* lda, int* info);
 void dpotrs_(const char* uplo, const int* n, const int* nrhs, const double* a, const int* lda,
              double* b, const int* ldb, int* info);
 }
@@ -105,15 +109,19 @@ LevelSeparator level_separator(const Sparse& a) {
   std::vector<int> count(static_cast<std::size_t>(depth), 0);
   for (const int l : level)
     if (l >= 0) ++count[static_cast<std::size_t>(l)];
-  int best = -1, rest_side = 1;
+  // The thinnest level that balances; of equally thin ones, and of the two sides for the other
+  // components, the most balanced.
+  int best = -1, rest_side = 1, best_gap = 0;
   for (int m = 1, below = count[0]; m + 1 < depth; below += count[m], ++m) {
     const int above = largest_size - below - count[m];
     for (int side = 0; side < 2; ++side) {
       const int halves[2] = {below + (side == 0 ? rest : 0), above + (side == 1 ? rest : 0)};
       if (std::min(halves[0], halves[1]) < 0.4 * (halves[0] + halves[1])) continue;
-      if (best < 0 || count[m] < count[best]) {
+      const int gap = std::abs(halves[0] - halves[1]);
+      if (best < 0 || count[m] < count[best] || (count[m] == count[best] && gap < best_gap)) {
         best = m;
         rest_side = side;
+        best_gap = gap;
       }
     }
   }
@@ -175,6 +183,21 @@ void lower_times(const Eigen::MatrixXd& l, char transpose, double* b, int column
     dtrmm_("L", "L", &transpose, "N", &s, &columns, &one, l.data(), &s, b, &ld);
 }
 
+// FNV-1a over a compressed matrix's column starts and row indices: factorize() checks the pattern
+// it is given against the analysed one.
+std::uint64_t pattern_hash(const Sparse& a) {
+  std::uint64_t h = 1469598103934665603ULL;
+  const auto mix = [&h](const int* p, Eigen::Index count) {
+    for (Eigen::Index k = 0; k < count; ++k) {
+      h ^= static_cast<std::uint32_t>(p[k]);
+      h *= 1099511628211ULL;
+    }
+  };
+  mix(a.outerIndexPtr(), a.outerSize() + 1);
+  mix(a.innerIndexPtr(), a.nonZeros());
+  return h;
+}
+
 Eigen::Map<Eigen::MatrixXd> as_matrix(cholmod_dense* d) {
   return {static_cast<double*>(d->x), static_cast<Eigen::Index>(d->nrow),
           static_cast<Eigen::Index>(d->ncol)};
@@ -191,11 +214,16 @@ struct Half {
   std::vector<Eigen::Index> source; // each value's index in the global matrix's values
   std::vector<int> order;           // the separator row at each of the factor's trailing rows
   Eigen::MatrixXd lss;              // the factor's trailing s × s block (lower triangular)
-  Eigen::MatrixXd product; // lss lssᵀ = K_SS − C_iᵀ A_i⁻¹ C_i (factor's order), until summed
+  // lss lssᵀ = K_SS − C_iᵀ A_i⁻¹ C_i until summed, as R Rᵀ (upper triangle) with R = J lss J,
+  // J the reversal of the rows: (lss lssᵀ)(a, b) = (R Rᵀ)(s−1−a, s−1−b).
+  Eigen::MatrixXd product;
   Eigen::MatrixXd rhs, t; // a solve's bordered right-hand side, and lss × its tail
   cholmod_dense *xa = nullptr, *xb = nullptr, *y = nullptr, *e = nullptr;
 
-  Half() { cholmod_start(&c); }
+  Half() {
+    cholmod_start(&c);
+    c.print = 0; // failures are reported by our exceptions, not on stdout
+  }
   ~Half() {
     cholmod_free_factor(&factor, &c);
     for (cholmod_dense** d : {&xa, &xb, &y, &e}) cholmod_free_dense(d, &c);
@@ -236,7 +264,6 @@ struct Half {
     c.nmethods = 1;
     c.method[0].ordering = CHOLMOD_GIVEN;
     c.postorder = 0;
-    c.print = 0;
     c.supernodal = CHOLMOD_SUPERNODAL;
     if (coarse) {
       const int nrelax[3] = {16, 64, 256};
@@ -279,8 +306,9 @@ struct Half {
         for (int r = j - super[k]; r < rows_of_node; ++r)
           lss(srow[pi[k] + r] - n, j - n) = x[px[k] + (j - super[k]) * rows_of_node + r];
     }
-    product = lss.transpose();
-    lower_times(lss, 'N', product.data(), s, s);
+    product = lss.reverse(); // upper triangular: LAPACK's dlauum forms R Rᵀ in s³/3 flops
+    int info = 0;
+    if (s > 0) dlauum_("U", &s, product.data(), &s, &info);
     return true;
   }
 
@@ -325,7 +353,9 @@ struct SplitCholesky::Impl {
   };
   std::vector<Entry> separator_entries; // K_SS's lower triangle, in separator rows
   Eigen::Index n = 0, nonzeros = 0;
-  Eigen::MatrixXd schur; // the Schur complement's Cholesky factor (lower triangle)
+  Eigen::MatrixXd schur;     // the Schur complement's Cholesky factor (lower triangle)
+  std::uint64_t pattern = 0; // pattern_hash() of the analysed matrix
+  bool factored = false;
 
   // The bordered matrix of half i: its pattern and where each value comes from.
   void build_half(const Sparse& a, const std::vector<int>& local, int i) {
@@ -373,6 +403,7 @@ bool SplitCholesky::analyze(const Sparse& a, int max_separator_rows, bool coarse
   if (split.part.empty() || split.separator_rows > max_separator_rows) return false;
   m.n = a.rows();
   m.nonzeros = a.nonZeros();
+  m.pattern = pattern_hash(a);
   // local[2v + i]: row v's local row in half i (-1: not in it)
   std::vector<int> local(static_cast<std::size_t>(2 * m.n), -1);
   for (int v = 0; v < m.n; ++v) {
@@ -409,8 +440,14 @@ bool SplitCholesky::analyze(const Sparse& a, int max_separator_rows, bool coarse
 
 bool SplitCholesky::factorize(const Sparse& a) {
   Impl& m = *impl_;
+  m.factored = false;
   if (m.half[0].factor == nullptr) throw InvalidArgument("cholmod: factorize() before analyze()");
-  if (a.rows() != m.n || a.nonZeros() != m.nonzeros || !a.isCompressed())
+  if (!a.isCompressed()) {
+    Sparse compressed = a;
+    compressed.makeCompressed();
+    return factorize(compressed);
+  }
+  if (a.rows() != m.n || a.nonZeros() != m.nonzeros || pattern_hash(a) != m.pattern)
     throw InvalidArgument("cholmod: factorize() needs the pattern given to analyze()");
   bool definite[2] = {false, false};
   on_both_halves([&](int i) { definite[i] = m.half[i].factorize(a.valuePtr()); });
@@ -420,10 +457,13 @@ bool SplitCholesky::factorize(const Sparse& a) {
   Eigen::MatrixXd& schur = m.schur;
   schur.setZero(s, s);
   for (Half& h : m.half) {
-    for (int b = 0; b < s; ++b)
-      for (int r = 0; r < s; ++r)
-        schur(h.order[static_cast<std::size_t>(r)], h.order[static_cast<std::size_t>(b)]) +=
-            h.product(r, b);
+    for (int j = 0; j < s; ++j) // the upper triangle of R Rᵀ: entry (i, j) is (s−1−i, s−1−j)
+      for (int i = 0; i <= j; ++i) {
+        const int r = h.order[static_cast<std::size_t>(s - 1 - i)];
+        const int c = h.order[static_cast<std::size_t>(s - 1 - j)];
+        schur(r, c) += h.product(i, j);
+        if (r != c) schur(c, r) += h.product(i, j);
+      }
     h.product = Eigen::MatrixXd();
   }
   for (const auto& e : m.separator_entries) {
@@ -433,11 +473,17 @@ bool SplitCholesky::factorize(const Sparse& a) {
   }
   int info = 0;
   if (s > 0) dpotrf_("L", &s, schur.data(), &s, &info);
-  return info == 0;
+  m.factored = info == 0;
+  return m.factored;
 }
 
 Eigen::MatrixXd SplitCholesky::solve(const Eigen::MatrixXd& b) {
   Impl& m = *impl_;
+  if (!m.factored) throw InvalidArgument("cholmod: solve() before a successful factorize()");
+  if (b.rows() != m.n)
+    throw InvalidArgument("cholmod: the right-hand side has " + std::to_string(b.rows()) +
+                          " rows for a system of dimension " + std::to_string(m.n));
+  if (b.cols() == 0) return Eigen::MatrixXd(b.rows(), 0);
   on_both_halves([&](int i) { m.half[i].forward(b); });
   const int s = static_cast<int>(m.separator.size());
   Eigen::MatrixXd xs(s, b.cols());
@@ -454,7 +500,8 @@ Eigen::MatrixXd SplitCholesky::solve(const Eigen::MatrixXd& b) {
 }
 
 std::size_t SplitCholesky::factor_nonzeros() const {
-  std::size_t count = impl_->separator.size() * impl_->separator.size();
+  const std::size_t s = impl_->separator.size();
+  std::size_t count = s * (s + 1) / 2; // the Schur complement's factor
   for (const Half& h : impl_->half)
     if (h.factor != nullptr) count += h.factor->xsize;
   return count;

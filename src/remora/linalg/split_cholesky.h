@@ -35,8 +35,8 @@ struct LevelSeparator {
 };
 
 /// The separator level whose halves are balanced within [0.4, 0.6] of the rest and which has the
-/// fewest rows, read from the lower triangle of `a` (n × n). Empty `part` when the graph is not
-/// connected or no level balances it.
+/// fewest rows, read from the lower triangle of `a` (n × n). The largest connected component is
+/// cut; the others join one half whole. Empty `part` when no level balances the halves.
 LevelSeparator level_separator(const Eigen::SparseMatrix<double>& a);
 
 class SplitCholesky {
@@ -46,16 +46,18 @@ public:
   SplitCholesky(const SplitCholesky&) = delete;
   SplitCholesky& operator=(const SplitCholesky&) = delete;
 
-  /// Splits the symmetric pattern of `a` (lower triangle read) and analyses both halves. Returns
-  /// false, keeping nothing, when no separator of at most `max_separator_rows` rows balances the
-  /// graph; the caller then factors `a` as one.
+  /// Splits the symmetric pattern of `a` (compressed; lower triangle read) and analyses both
+  /// halves, with coarser supernodes than CHOLMOD's defaults when `coarse_supernodes`
+  /// (solver.cpp). Returns false, keeping nothing, when `a` is not compressed or no separator of
+  /// at most `max_separator_rows` rows balances the graph; the caller then factors `a` as one.
   bool analyze(const Eigen::SparseMatrix<double>& a, int max_separator_rows,
                bool coarse_supernodes);
   /// The numbers of `a`, which has the pattern given to analyze(). Returns false when `a` is not
   /// positive definite; throws NumericalError when CHOLMOD fails otherwise (out of memory), and
   /// InvalidArgument for another pattern.
   bool factorize(const Eigen::SparseMatrix<double>& a);
-  /// X with A X = B, B of n rows.
+  /// X with A X = B, B of n rows. Throws InvalidArgument before a successful factorize() or for
+  /// another row count.
   Eigen::MatrixXd solve(const Eigen::MatrixXd& b);
 
   std::size_t factor_nonzeros() const;
