@@ -7,7 +7,8 @@
 //   cholmod     SPD          CHOLMOD supernodal Cholesky, AMD or METIS ordering (GPL module;
 //                            only when built with REMORA_WITH_GPL_SOLVERS, then the default);
 //                            with AMD, two threads and 8,000 rows or more, two halves around a
-//                            separator on two threads (split_cholesky.h)
+//                            separator on two threads when a thin one balances them
+//                            (split_cholesky.h)
 //   ldlt        SPD          Eigen SimplicialLDLT, AMD ordering (the permissive default)
 //   llt         SPD          Eigen SimplicialLLT, AMD ordering (what libigl's
 //                            min_quad_with_fixed uses; kept as the yardstick)
@@ -41,7 +42,8 @@ struct SolverOptions {
   /// surface mesh grows like sqrt(n), its storage like n^1.5).
   std::size_t max_band_bytes = std::size_t(4) << 30;
   /// cholmod (amd): with 2 threads or more, a system of 8,000 rows or more is factored as two
-  /// halves around a separator, one per thread (split_cholesky.h); 1 = CHOLMOD's one factor.
+  /// halves around a separator, one per thread, when a thin separator balances them
+  /// (split_cholesky.h); 1 = CHOLMOD's one factor.
   int threads = 0; ///< 0 = all hardware threads
 };
 
