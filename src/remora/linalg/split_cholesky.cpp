@@ -86,7 +86,9 @@ LevelSeparator level_separator(const Sparse& a) {
   // The largest connected component is split by a level; the others join one half whole.
   std::vector<int> level(static_cast<std::size_t>(n), -1), queue;
   std::vector<char> seen(level.size(), 0);
-  int largest = -1, largest_size = 0, last = 0;
+  // Each component's breadth-first search from its first row ends at one of the rows farthest
+  // from it: the largest component's is where its levels start (a pseudo-peripheral row).
+  int far = -1, largest_size = 0, last = 0;
   for (int v = 0; v < n; ++v) {
     if (seen[static_cast<std::size_t>(v)]) continue;
     queue.assign(1, v);
@@ -99,11 +101,10 @@ LevelSeparator level_separator(const Sparse& a) {
         }
     if (static_cast<int>(queue.size()) > largest_size) {
       largest_size = static_cast<int>(queue.size());
-      largest = v;
+      far = queue.back();
     }
   }
-  bfs_levels(g, largest, level, last);
-  bfs_levels(g, last, level, last);  // from a pseudo-peripheral row: thin, balanced levels
+  bfs_levels(g, far, level, last);   // thin, balanced levels
   const int rest = n - largest_size; // rows of the other components
   const int depth = level[static_cast<std::size_t>(last)] + 1;
   std::vector<int> count(static_cast<std::size_t>(depth), 0);
