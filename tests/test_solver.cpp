@@ -286,6 +286,20 @@ bool couples_the_halves(const SparseMatrix& a, const LevelSeparator& s) {
   return false;
 }
 
+// The block-diagonal matrix [a 0; 0 b].
+SparseMatrix block_diagonal(const SparseMatrix& a, const SparseMatrix& b) {
+  std::vector<Eigen::Triplet<double>> t;
+  for (const SparseMatrix* block : {&a, &b})
+    for (int j = 0; j < block->outerSize(); ++j)
+      for (SparseMatrix::InnerIterator it(*block, j); it; ++it) {
+        const auto shift = static_cast<int>(block == &a ? 0 : a.rows());
+        t.emplace_back(static_cast<int>(it.row()) + shift, j + shift, it.value());
+      }
+  SparseMatrix both(a.rows() + b.rows(), a.cols() + b.cols());
+  both.setFromTriplets(t.begin(), t.end());
+  return both;
+}
+
 TEST(SplitCholesky, TheSeparatorDecouplesTwoBalancedHalves) {
   const KHarmonicSystem big = sphere_system(2, AreaWeights::Mean, 5);
   const LevelSeparator s = level_separator(big.matrix);
@@ -300,15 +314,7 @@ TEST(SplitCholesky, TheSeparatorDecouplesTwoBalancedHalves) {
   // A second component (a small sphere's rows) joins one half whole.
   const KHarmonicSystem small = sphere_system(2, AreaWeights::Mean, 3);
   const auto m = static_cast<int>(small.matrix.rows());
-  std::vector<Eigen::Triplet<double>> t;
-  for (const SparseMatrix* block : {&big.matrix, &small.matrix})
-    for (int j = 0; j < block->outerSize(); ++j)
-      for (SparseMatrix::InnerIterator it(*block, j); it; ++it) {
-        const int shift = block == &big.matrix ? 0 : n;
-        t.emplace_back(static_cast<int>(it.row()) + shift, j + shift, it.value());
-      }
-  SparseMatrix both(n + m, n + m);
-  both.setFromTriplets(t.begin(), t.end());
+  const SparseMatrix both = block_diagonal(big.matrix, small.matrix);
   const LevelSeparator two = level_separator(both);
   ASSERT_EQ(two.part.size(), static_cast<std::size_t>(n + m));
   EXPECT_FALSE(couples_the_halves(both, two));
@@ -359,15 +365,7 @@ TEST(SplitCholesky, ASecondComponentIsSolvedWithItsHalf) {
   const KHarmonicSystem small = sphere_system(1, AreaWeights::Mean, 3);
   const auto n = static_cast<int>(big.matrix.rows());
   const auto m = static_cast<int>(small.matrix.rows());
-  std::vector<Eigen::Triplet<double>> t;
-  for (int j = 0; j < n; ++j)
-    for (SparseMatrix::InnerIterator it(big.matrix, j); it; ++it)
-      t.emplace_back(static_cast<int>(it.row()), j, it.value());
-  for (int j = 0; j < m; ++j)
-    for (SparseMatrix::InnerIterator it(small.matrix, j); it; ++it)
-      t.emplace_back(static_cast<int>(it.row()) + n, j + n, it.value());
-  SparseMatrix both(n + m, n + m);
-  both.setFromTriplets(t.begin(), t.end());
+  const SparseMatrix both = block_diagonal(big.matrix, small.matrix);
   Eigen::MatrixXd b(n + m, 3);
   b << block_rhs(big), block_rhs(small);
   SplitCholesky split;
