@@ -204,6 +204,11 @@ Eigen::Map<Eigen::MatrixXd> as_matrix(cholmod_dense* d) {
           static_cast<Eigen::Index>(d->ncol)};
 }
 
+} // namespace
+
+// Named, not anonymous: SplitCholesky::Impl holds it (GCC's -Wsubobject-linkage in unity builds).
+namespace split_detail {
+
 // One half bordered by the separator: local rows 0..n−1 are the half's, n..n+s−1 the separator's.
 struct Half {
   cholmod_common c{};
@@ -343,7 +348,9 @@ struct Half {
   }
 };
 
-} // namespace
+} // namespace split_detail
+
+using split_detail::Half;
 
 struct SplitCholesky::Impl {
   Half half[2];
