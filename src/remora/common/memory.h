@@ -22,10 +22,10 @@ std::uint64_t physical_memory_bytes();
 bool keep_freed_memory();
 
 /// Allocates `bytes`, writes a byte of every page and frees them, so that under
-/// keep_freed_memory() a later allocation of up to that size finds pages already faulted in. On
-/// a VM where a page's first touch costs about 10 µs, a region's factor of 40-50 MB otherwise
-/// pays 0.1 s in page faults (docs/benchmarks.md). Cheap where the heap already holds a free
-/// block that large (its pages are warm). Returns the page faults it took (getrusage's minor
+/// keep_freed_memory() a later allocation of up to that size finds pages already faulted in
+/// (where a page's first touch is slow, as on a VM, a region's factor otherwise pays for each of
+/// its pages; docs/server.md, "A warm heap"). Cheap where the heap already holds a free block
+/// that large (its pages are warm). Returns the page faults it took (getrusage's minor
 /// faults of the process, so other threads' count too); 0 and nothing done when the allocation
 /// fails.
 std::uint64_t warm_heap(std::size_t bytes);

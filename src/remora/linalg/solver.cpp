@@ -14,6 +14,8 @@
 #ifdef REMORA_WITH_GPL_SOLVERS
 #include <Eigen/CholmodSupport>
 #include <Eigen/UmfPackSupport>
+
+#include "remora/linalg/cholmod_settings.h"
 #endif
 
 #include "remora/common/error.h"
@@ -121,8 +123,7 @@ public:
     n_ = a.rows();
     // Two halves on two threads (split_cholesky.h) when both threads are free: not inside an
     // active OpenMP region, where the halves would run one after the other.
-    if (!metis_ && threads_ >= 2 && omp_get_active_level() == 0 && n_ >= kSplitRows &&
-        a.isCompressed()) {
+    if (!metis_ && threads_ >= 2 && omp_get_active_level() == 0 && n_ >= kSplitRows) {
       auto split = std::make_unique<SplitCholesky>();
       // The dense blocks hold five s × s doubles at once while factoring: s ≤ √(16 n) keeps them
       // under 640 bytes per row (docs/limits.md).
@@ -138,7 +139,7 @@ public:
     c.method[0].ordering = metis_ ? CHOLMOD_METIS : CHOLMOD_AMD;
     c.postorder = 1;
     c.print = 0; // failures are reported by our exception, not on stdout
-    coarse_supernodes(a.rows() <= kCoarseSupernodesRows);
+    set_supernodes(c, a.rows() <= kCoarseSupernodesRows);
     llt_->analyzePattern(a);
   }
   void factorize(const Sparse& a) override {
@@ -185,13 +186,8 @@ public:
       return split_->solve(b);
     }
     cholmod_factor* l = const_cast<cholmod_factor*>(llt_->factor());
-    cholmod_dense rhs{};
-    rhs.nrow = rhs.d = static_cast<std::size_t>(b.rows());
-    rhs.ncol = static_cast<std::size_t>(b.cols());
-    rhs.nzmax = rhs.nrow * rhs.ncol;
-    rhs.x = const_cast<double*>(b.data());
-    rhs.xtype = CHOLMOD_REAL;
-    rhs.dtype = CHOLMOD_DOUBLE;
+    cholmod_dense rhs = dense_view(b.data(), static_cast<std::size_t>(b.rows()),
+                                   static_cast<std::size_t>(b.cols()));
     cholmod_common& c = llt_->cholmod();
     std::optional<BlasThreadsScope> one_blas_thread;
     if (small_) one_blas_thread.emplace();
@@ -217,21 +213,11 @@ private:
     factored_ = false;
     stats_ = SolverStats{};
   }
-  // Coarser supernodes than CHOLMOD's defaults (4, 16, 48 and 0.8, 0.1, 0.05) for a system of up
-  // to kCoarseSupernodesRows rows: a mesh's supernodes are small, and such a factor spends its
-  // time between BLAS calls, not in them. Merging more of them stores more explicit zeros, 28 %
-  // more at 479k rows for an 8 % faster factor, so larger systems keep the defaults and the
-  // region memory estimate of docs/limits.md (docs/solvers.md).
+  // Coarser supernodes (set_supernodes) for a system of up to kCoarseSupernodesRows rows. Merging
+  // more of them stores more explicit zeros, 28 % more at 479k rows for an 8 % faster factor, so
+  // larger systems keep the defaults and the region memory estimate of docs/limits.md
+  // (docs/solvers.md).
   static constexpr Eigen::Index kCoarseSupernodesRows = 200000;
-  void coarse_supernodes(bool coarse) {
-    cholmod_common& c = llt_->cholmod();
-    const int nrelax[2][3] = {{4, 16, 48}, {16, 64, 256}};
-    const double zrelax[2][3] = {{0.8, 0.1, 0.05}, {0.9, 0.3, 0.1}};
-    for (int i = 0; i < 3; ++i) {
-      c.nrelax[i] = static_cast<std::size_t>(nrelax[coarse][i]);
-      c.zrelax[i] = zrelax[coarse][i];
-    }
-  }
   // Below this many flops (the analysis's estimate) the factor and its solves hold the BLAS at
   // one thread (blas_threads.h): at 0.83 GFlop (the bunny's 30k-vertex thin plate) one thread
   // is faster, and the editor's threads after it are not slowed; at 9.1 GFlop (igea_sub4's 119k)

@@ -12,6 +12,8 @@
 #ifdef REMORA_WITH_GPL_SOLVERS
 #include <cholmod.h>
 
+#include "remora/linalg/cholmod_settings.h"
+
 extern "C" { // BLAS and LAPACK (OpenBLAS, whose kernels use the machine's vector width)
 void dtrmm_(const char* side, const char* uplo, const char* transa, const char* diag, const int* m,
             const int* n, const double* alpha, const double* a, const int* lda, double* b,
@@ -164,17 +166,6 @@ void on_both_halves(Body&& body) {
     if (e) std::rethrow_exception(e);
 }
 
-cholmod_dense dense_view(Eigen::MatrixXd& m) {
-  cholmod_dense d{};
-  d.nrow = d.d = static_cast<std::size_t>(m.rows());
-  d.ncol = static_cast<std::size_t>(m.cols());
-  d.nzmax = d.nrow * d.ncol;
-  d.x = m.data();
-  d.xtype = CHOLMOD_REAL;
-  d.dtype = CHOLMOD_DOUBLE;
-  return d;
-}
-
 // b = l b or lᵀ b (transpose 'T'), l lower triangular, b a column-major block of leading
 // dimension ld.
 void lower_times(const Eigen::MatrixXd& l, char transpose, double* b, int columns, int ld) {
@@ -271,14 +262,7 @@ struct Half {
     c.method[0].ordering = CHOLMOD_GIVEN;
     c.postorder = 0;
     c.supernodal = CHOLMOD_SUPERNODAL;
-    if (coarse) {
-      const int nrelax[3] = {16, 64, 256};
-      const double zrelax[3] = {0.9, 0.3, 0.1};
-      for (int i = 0; i < 3; ++i) {
-        c.nrelax[i] = static_cast<std::size_t>(nrelax[i]);
-        c.zrelax[i] = zrelax[i];
-      }
-    }
+    set_supernodes(c, coarse);
     factor = cholmod_analyze_p(&m, perm.data(), nullptr, 0, &c);
     if (factor == nullptr)
       throw NumericalError("cholmod: the symbolic analysis failed (out of memory?)");
@@ -327,7 +311,8 @@ struct Half {
   void forward(const Eigen::MatrixXd& b) {
     rhs.setZero(size(), b.cols());
     for (int l = 0; l < n; ++l) rhs.row(l) = b.row(rows[static_cast<std::size_t>(l)]);
-    cholmod_dense in = dense_view(rhs);
+    cholmod_dense in = dense_view(rhs.data(), static_cast<std::size_t>(rhs.rows()),
+                                  static_cast<std::size_t>(rhs.cols()));
     sweep(CHOLMOD_P, &in, &xa);
     sweep(CHOLMOD_L, xa, &xb);
     t = as_matrix(xb).bottomRows(separator_rows());

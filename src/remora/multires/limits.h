@@ -43,8 +43,7 @@ std::uint64_t region_bytes(std::size_t free_vertices, int k, int handles);
 
 /// How much heap an app warms after building an editor (common/memory.h, warm_heap()): a
 /// region over every base vertex at order k (region_bytes), at most kWarmHeapBytes. The first
-/// regions then fault in no fresh pages: on the bunny set_region took 150-160 ms instead of
-/// 300-340 ms for the first region and 180-220 ms for the next (docs/benchmarks.md).
+/// regions then fault in no fresh pages (docs/server.md, "A warm heap").
 inline constexpr std::uint64_t kWarmHeapBytes = std::uint64_t(256) << 20;
 std::uint64_t warm_heap_bytes(std::size_t base_vertices, int k);
 
