@@ -262,6 +262,57 @@ TEST(Bake, MatchesAFullPreprocessAndKeepsTheRestBitForBit) {
   }
 }
 
+#ifdef REMORA_WITH_GPL_SOLVERS
+// Editor::order_base: regions' factors follow the base's nested dissection and solve as CAMD's
+// halves do; a bake carries the order over to the new base, and the next regions follow it.
+TEST(Bake, CarriesTheBasesOrderAndTheRegionsFollowIt) {
+  const Mesh bunny = read_mesh(std::string(REMORA_REPO_DATA) + "/bunny.ply").mesh;
+  const VertexHandle back = nearest_vertex(bunny, Vec3(-0.03, 0.12, -0.03));
+  const double diagonal = bounding_box_diagonal(bunny);
+  Editor ordered(bunny, two_threads()), plain(bunny, two_threads());
+  ordered.order_base();
+  const EditorPartsView p = ordered.parts();
+  ASSERT_EQ(p.base_order.size(), ordered.base().n_vertices());
+  EXPECT_EQ(p.base_order_k, 2);
+  std::vector<int> sorted = p.base_order;
+  std::sort(sorted.begin(), sorted.end());
+  for (std::size_t k = 0; k < sorted.size(); ++k) ASSERT_EQ(sorted[k], static_cast<int>(k));
+  EXPECT_TRUE(plain.parts().base_order.empty());
+  const BakeRegion large = region(bunny, back, 20000);
+  Eigen::MatrixXd moved[2];
+  Editor* editors[2] = {&ordered, &plain};
+  for (int e = 0; e < 2; ++e) {
+    editors[e]->set_region(large.support, {large.handle});
+    const SolverStats& stats = editors[e]->report().solver_stats;
+    EXPECT_EQ(stats.keyed_order, e == 0);
+    EXPECT_GT(stats.separator_rows, 0);
+    editors[e]->set_transform(0, lift(*editors[e], back, 0.04 * diagonal));
+    moved[e] = editors[e]->positions();
+  }
+  EXPECT_LT(max_row_distance(moved[0], moved[1]), 1e-9 * diagonal);
+
+  // A move of a small region, baked locally: the order is carried over.
+  const BakeRegion small = region(bunny, back, 3000);
+  ordered.set_region(small.support, {small.handle});
+  ordered.set_transform(0, lift(ordered, back, 0.04 * diagonal));
+  BakeResult baked = bake(ordered);
+  ASSERT_TRUE(baked.report.local) << baked.report.fallback;
+  const EditorPartsView q = baked.editor.parts();
+  ASSERT_EQ(q.base_order.size(), baked.editor.base().n_vertices());
+  EXPECT_EQ(q.base_order_k, 2);
+  for (const int key : q.base_order) ASSERT_TRUE(key >= 0 && key < static_cast<int>(sorted.size()));
+  baked.editor.set_region(large.support, {large.handle});
+  EXPECT_TRUE(baked.editor.report().solver_stats.keyed_order);
+  EXPECT_GT(baked.editor.report().solver_stats.separator_rows, 0);
+  // A full re-preprocess orders its base afresh.
+  BakeOptions full_options;
+  full_options.force_full = true;
+  BakeResult full = bake(ordered, full_options);
+  ASSERT_FALSE(full.report.local);
+  EXPECT_EQ(full.editor.parts().base_order.size(), full.editor.base().n_vertices());
+}
+#endif
+
 TEST(Bake, TheReportFollowsTheBaseThroughBakesOfBakesAtABoundary) {
   // Three bakes in a row, each of the last one's editor, around a hole of the bunny, on one
   // thread: the valences and counts updated where faces changed are the base's own, boundary

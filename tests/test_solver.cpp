@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <memory>
 #include <numeric>
 #include <random>
@@ -12,6 +13,7 @@
 #include "remora/common/error.h"
 #include "remora/linalg/blas_threads.h"
 #include "remora/linalg/kharmonic.h"
+#include "remora/linalg/nested_dissection.h"
 #include "remora/linalg/solver.h"
 #include "remora/linalg/split_cholesky.h"
 #include "remora/mesh/primitives.h"
@@ -278,12 +280,39 @@ TEST(Solver, ReverseCuthillMcKeeShrinksTheBandOfAScrambledGrid) {
 // ---- The two-half factorization (split_cholesky.h) -----------------------------------------
 
 // Whether a symmetric matrix couples a row of part 0 with one of part 1.
-bool couples_the_halves(const SparseMatrix& a, const LevelSeparator& s) {
+bool couples_the_halves(const SparseMatrix& a, const Separator& s) {
   for (int j = 0; j < a.outerSize(); ++j)
     for (SparseMatrix::InnerIterator it(a, j); it; ++it)
       if (s.part[static_cast<std::size_t>(it.row())] + s.part[static_cast<std::size_t>(j)] == 1)
         return true;
   return false;
+}
+
+// A split of a's rows into two halves that do not couple, within 40/60 of each other, and a
+// separator whose count is its rows'.
+void expect_a_balanced_split(const SparseMatrix& a, const Separator& s) {
+  const auto n = static_cast<int>(a.rows());
+  ASSERT_EQ(s.part.size(), static_cast<std::size_t>(n));
+  EXPECT_FALSE(couples_the_halves(a, s));
+  EXPECT_EQ(s.rows[0] + s.rows[1] + s.separator_rows, n);
+  EXPECT_EQ(std::count(s.part.begin(), s.part.end(), 2), s.separator_rows);
+  EXPECT_GE(std::min(s.rows[0], s.rows[1]), 0.4 * (s.rows[0] + s.rows[1]));
+}
+
+bool is_a_permutation(std::vector<int> keys) {
+  std::sort(keys.begin(), keys.end());
+  for (std::size_t k = 0; k < keys.size(); ++k)
+    if (keys[k] != static_cast<int>(k)) return false;
+  return true;
+}
+
+// The keys of a system's rows in the order of its mesh (the base's order, as the editor gives
+// them).
+std::vector<int> region_keys(const std::vector<int>& mesh_keys, const KHarmonicSystem& s) {
+  std::vector<int> keys(s.free_vertices.size());
+  for (std::size_t r = 0; r < keys.size(); ++r)
+    keys[r] = mesh_keys[static_cast<std::size_t>(s.free_vertices[r])];
+  return keys;
 }
 
 // The block-diagonal matrix [a 0; 0 b].
@@ -302,20 +331,16 @@ SparseMatrix block_diagonal(const SparseMatrix& a, const SparseMatrix& b) {
 
 TEST(SplitCholesky, TheSeparatorDecouplesTwoBalancedHalves) {
   const KHarmonicSystem big = sphere_system(2, AreaWeights::Mean, 5);
-  const LevelSeparator s = level_separator(big.matrix);
+  const Separator s = level_separator(big.matrix);
   const auto n = static_cast<int>(big.matrix.rows());
-  ASSERT_EQ(s.part.size(), static_cast<std::size_t>(n));
-  EXPECT_FALSE(couples_the_halves(big.matrix, s));
-  EXPECT_EQ(s.rows[0] + s.rows[1] + s.separator_rows, n);
-  EXPECT_EQ(std::count(s.part.begin(), s.part.end(), 2), s.separator_rows);
-  EXPECT_GE(std::min(s.rows[0], s.rows[1]), 0.4 * (s.rows[0] + s.rows[1]));
+  expect_a_balanced_split(big.matrix, s);
   EXPECT_LT(s.separator_rows, n / 10); // a band across the sphere, not a slab of it
 
   // A second component (a small sphere's rows) joins one half whole.
   const KHarmonicSystem small = sphere_system(2, AreaWeights::Mean, 3);
   const auto m = static_cast<int>(small.matrix.rows());
   const SparseMatrix both = block_diagonal(big.matrix, small.matrix);
-  const LevelSeparator two = level_separator(both);
+  const Separator two = level_separator(both);
   ASSERT_EQ(two.part.size(), static_cast<std::size_t>(n + m));
   EXPECT_FALSE(couples_the_halves(both, two));
   for (int v = n; v < n + m; ++v) ASSERT_EQ(two.part[static_cast<std::size_t>(v)], two.part[n]);
@@ -329,6 +354,81 @@ TEST(SplitCholesky, TheSeparatorDecouplesTwoBalancedHalves) {
 }
 
 #ifdef REMORA_WITH_GPL_SOLVERS
+// The base's order (nested_dissection.h) of a region: the rows of one mesh-wide order, as the
+// editor gives them (Editor::order_base). Its tree separator cuts the region into halves that do
+// not couple, thinner than a breadth-first level, and its keys are a postorder of the tree.
+TEST(SplitCholesky, TheTreeOfANestedDissectionGivesAThinSeparator) {
+  const Mesh mesh = make_icosphere(5);
+  const KHarmonicAssembler assembler(mesh);
+  const std::vector<int> base = nested_dissection_keys(ring_pattern(assembler.minus_w(), 2));
+  ASSERT_EQ(base.size(), mesh.n_vertices());
+  EXPECT_TRUE(is_a_permutation(base));
+  const KHarmonicSystem s = sphere_system(2, AreaWeights::Mean, 5);
+  const Separator tree = tree_separator(s.matrix, region_keys(base, s));
+  const auto n = static_cast<int>(s.matrix.rows());
+  expect_a_balanced_split(s.matrix, tree);
+  EXPECT_LT(tree.separator_rows, std::sqrt(16.0 * n)); // under the solver's cap
+  // The keys: a permutation in which every row comes before its neighbours in the separator.
+  ASSERT_EQ(tree.keys.size(), static_cast<std::size_t>(n));
+  EXPECT_TRUE(is_a_permutation(tree.keys));
+  for (int j = 0; j < n; ++j)
+    for (SparseMatrix::InnerIterator it(s.matrix, j); it; ++it)
+      if (tree.part[static_cast<std::size_t>(j)] == 2 &&
+          tree.part[static_cast<std::size_t>(it.row())] != 2) {
+        ASSERT_LT(tree.keys[static_cast<std::size_t>(it.row())],
+                  tree.keys[static_cast<std::size_t>(j)]);
+      }
+  // A chain (a path graph in its own order) has no two subtrees to balance.
+  SparseMatrix path(50, 50);
+  for (int v = 0; v < 50; ++v) path.insert(v, v) = 4.0;
+  for (int v = 1; v < 50; ++v) path.insert(v, v - 1) = -1.0;
+  std::vector<int> in_order(50);
+  std::iota(in_order.begin(), in_order.end(), 0);
+  EXPECT_TRUE(tree_separator(path, in_order).part.empty());
+  EXPECT_TRUE(tree_separator(s.matrix, std::vector<int>(3, 0)).part.empty()); // wrong count
+}
+
+// In the base's order the halves solve as one factor does; keys of the wrong count are refused.
+TEST(SplitCholesky, HalvesInTheBasesOrderSolveAsOneFactorDoes) {
+  const Mesh mesh = make_icosphere(5);
+  const KHarmonicAssembler assembler(mesh);
+  for (int k = 1; k <= 3; ++k) {
+    SCOPED_TRACE(::testing::Message() << "k " << k);
+    const std::vector<int> base = nested_dissection_keys(ring_pattern(assembler.minus_w(), k));
+    const KHarmonicSystem s = sphere_system(k, AreaWeights::Mean, 5);
+    std::vector<int> keys = region_keys(base, s);
+    const Eigen::MatrixXd b = block_rhs(s);
+    auto reference = make_solver({.name = "ldlt"});
+    reference->compute(s.matrix);
+    const Eigen::MatrixXd x = reference->solve(b);
+    SplitCholesky split;
+    ASSERT_TRUE(split.analyze(s.matrix, 5000, true, keys));
+    ASSERT_TRUE(split.factorize(s.matrix));
+    EXPECT_LE(relative_difference(split.solve(b), x), 1e-9);
+    keys.pop_back();
+    EXPECT_THROW(split.analyze(s.matrix, 5000, true, keys), InvalidArgument);
+  }
+  EXPECT_THROW(nested_dissection_keys(SparseMatrix(3, 4)), InvalidArgument);
+  // Through the solver's interface, on two threads (24.6k rows): the same solution.
+  const Mesh fine = make_icosphere(6);
+  const std::vector<int> base =
+      nested_dissection_keys(ring_pattern(KHarmonicAssembler(fine).minus_w(), 2));
+  const KHarmonicSystem s = sphere_system(2, AreaWeights::Mean, 6);
+  std::vector<int> keys = region_keys(base, s);
+  const Eigen::MatrixXd b = block_rhs(s);
+  auto reference = make_solver({.name = "ldlt"});
+  reference->compute(s.matrix);
+  auto solver = make_solver({.name = "cholmod", .threads = 2});
+  solver->set_order_keys(keys);
+  solver->compute(s.matrix);
+  EXPECT_TRUE(solver->stats().keyed_order);
+  EXPECT_GT(solver->stats().separator_rows, 0);
+  EXPECT_LE(relative_difference(solver->solve(b), reference->solve(b)), 1e-9);
+  keys.pop_back();
+  solver->set_order_keys(keys);
+  EXPECT_THROW(solver->analyze(s.matrix), InvalidArgument);
+}
+
 TEST(SplitCholesky, TwoHalvesSolveAsOneFactorDoes) {
   for (int k = 1; k <= 3; ++k) {
     SCOPED_TRACE(::testing::Message() << "k " << k);

@@ -278,6 +278,10 @@ public:
     locked([&] { editor_->set_system(system); });
   }
 
+  void order_base() {
+    locked([&] { editor_->order_base(); });
+  }
+
   int handle_count() {
     return locked([&] { return editor_->handle_count(); });
   }
@@ -332,6 +336,7 @@ void bind_editor(py::module_& m) {
       .def("base_positions", &PyEditor::base_positions)
       .def("low_pass", &PyEditor::low_pass, py::arg("values"))
       .def("set_system", &PyEditor::set_system, py::arg("k"), py::arg("areas"))
+      .def("order_base", &PyEditor::order_base)
       .def("handle_count", &PyEditor::handle_count)
       .def("movable_vertices", &PyEditor::movable_vertices)
       .def("handle_center", &PyEditor::handle_center, py::arg("handle"))

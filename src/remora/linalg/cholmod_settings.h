@@ -1,4 +1,5 @@
-// What the two CHOLMOD users (solver.cpp's one factor, split_cholesky.cpp's two halves) set alike.
+// What CHOLMOD's users (solver.cpp's one factor, split_cholesky.cpp's two halves,
+// nested_dissection.cpp's order) set alike.
 // Only in builds with the GPL solvers.
 #pragma once
 
@@ -31,6 +32,25 @@ inline cholmod_dense dense_view(const double* data, std::size_t rows, std::size_
   d.xtype = CHOLMOD_REAL;
   d.dtype = CHOLMOD_DOUBLE;
   return d;
+}
+
+/// A packed, sorted lower triangle in CSC (n × n, 32-bit indices) as CHOLMOD's symmetric sparse
+/// matrix, without a copy; a pattern alone when `values` is null.
+inline cholmod_sparse lower_view(std::size_t n, std::size_t nonzeros, int* colptr, int* rowind,
+                                 double* values) {
+  cholmod_sparse m{};
+  m.nrow = m.ncol = n;
+  m.nzmax = nonzeros;
+  m.p = colptr;
+  m.i = rowind;
+  m.x = values;
+  m.stype = -1;
+  m.itype = CHOLMOD_INT;
+  m.xtype = values ? CHOLMOD_REAL : CHOLMOD_PATTERN;
+  m.dtype = CHOLMOD_DOUBLE;
+  m.sorted = 1;
+  m.packed = 1;
+  return m;
 }
 
 } // namespace remora

@@ -5,6 +5,7 @@
 #include <limits>
 #include <optional>
 #include <queue>
+#include <utility>
 
 #include <Eigen/IterativeLinearSolvers>
 #include <Eigen/SparseCholesky>
@@ -128,11 +129,14 @@ public:
       // The dense blocks hold five s × s doubles at once while factoring: s ≤ √(16 n) keeps them
       // under 640 bytes per row (docs/limits.md).
       const double max_rows = std::min(double(kMaxSeparatorRows), std::sqrt(16.0 * double(n_)));
-      if (split->analyze(a, static_cast<int>(max_rows), n_ <= kCoarseSupernodesRows)) {
+      if (split->analyze(a, static_cast<int>(max_rows), n_ <= kCoarseSupernodesRows, keys_)) {
         split_ = std::move(split);
         return;
       }
     }
+    if (!keys_.empty() && static_cast<Eigen::Index>(keys_.size()) != n_)
+      throw InvalidArgument("cholmod: " + std::to_string(keys_.size()) + " order keys for " +
+                            std::to_string(n_) + " rows; give one per row or none");
     llt_ = std::make_unique<ExposedCholmod>();
     cholmod_common& c = llt_->cholmod();
     c.nmethods = 1;
@@ -151,6 +155,7 @@ public:
       stats_.factor_nonzeros = split_->factor_nonzeros();
       stats_.factor_bytes = split_->factor_bytes();
       stats_.separator_rows = split_->separator_rows();
+      stats_.keyed_order = !keys_.empty();
       factored_ = true;
       return;
     }
@@ -195,6 +200,7 @@ public:
       throw NumericalError("cholmod: the solve failed (out of memory?)");
     return Eigen::Map<const Eigen::MatrixXd>(static_cast<const double*>(x_->x), b.rows(), b.cols());
   }
+  void set_order_keys(std::vector<int> keys) override { keys_ = std::move(keys); }
   ~CholmodSolver() override { release(); }
   CholmodSolver(const CholmodSolver&) = delete;
   CholmodSolver& operator=(const CholmodSolver&) = delete;
@@ -229,6 +235,7 @@ private:
   static constexpr int kMaxSeparatorRows = 3000;
   bool metis_;
   int threads_;
+  std::vector<int> keys_;                // set_order_keys()
   std::unique_ptr<SplitCholesky> split_; // the two-half factor, or
   std::unique_ptr<ExposedCholmod> llt_;  // the one factor
   bool factored_ = false;

@@ -52,8 +52,9 @@ struct SolverStats {
   double residual = 0.0;        ///< iterative: the largest relative residual of the last solve
   std::size_t factor_bytes = 0; ///< direct: memory of the factor (values and indices)
   std::size_t factor_nonzeros = 0;
-  int bandwidth = 0;      ///< banded: half-bandwidth after the ordering
-  int separator_rows = 0; ///< cholmod: the separator's rows when factored in two halves, else 0
+  int bandwidth = 0;        ///< banded: half-bandwidth after the ordering
+  int separator_rows = 0;   ///< cholmod: the separator's rows when factored in two halves, else 0
+  bool keyed_order = false; ///< cholmod: the halves followed set_order_keys()
 };
 
 class Solver {
@@ -75,6 +76,13 @@ public:
   virtual Eigen::MatrixXd solve(const Eigen::MatrixXd& b,
                                 const Eigen::MatrixXd* guess = nullptr) = 0;
   virtual SolverStats stats() const { return stats_; }
+  /// A fill-reducing order for the next analyze(): a key per row, the rows taken by increasing
+  /// key (ties by row), e.g. a nested dissection of a larger graph restricted to the system's
+  /// rows (nested_dissection.h). Empty: the solver orders the rows itself. Only `cholmod`'s two
+  /// halves follow it (each half's rows, then the separator's, by key, instead of CAMD); the
+  /// other solvers and `cholmod`'s one factor order as before. analyze() throws InvalidArgument
+  /// when the keys are not one per row.
+  virtual void set_order_keys(std::vector<int> keys) { (void)keys; }
 
 protected:
   SolverStats stats_;

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <cstdlib>
 #include <exception>
+#include <numeric>
 #include <string>
 
 #include "remora/common/error.h"
@@ -27,128 +28,11 @@ void dpotrs_(const char* uplo, const int* n, const int* nrhs, const double* a, c
 
 namespace remora {
 
-namespace {
-
-using Sparse = Eigen::SparseMatrix<double>;
-
-// The graph of a symmetric pattern (lower triangle of `a`), without its diagonal, as CSR.
-struct Graph {
-  std::vector<int> begin, next;
-};
-
-Graph adjacency(const Sparse& a) {
-  const int n = static_cast<int>(a.rows());
-  std::vector<int> degree(static_cast<std::size_t>(n), 0);
-  for (int j = 0; j < a.outerSize(); ++j)
-    for (Sparse::InnerIterator it(a, j); it; ++it)
-      if (it.row() > j) {
-        ++degree[static_cast<std::size_t>(it.row())];
-        ++degree[static_cast<std::size_t>(j)];
-      }
-  Graph g;
-  g.begin.assign(static_cast<std::size_t>(n) + 1, 0);
-  for (int i = 0; i < n; ++i) g.begin[i + 1] = g.begin[i] + degree[i];
-  g.next.resize(static_cast<std::size_t>(g.begin[n]));
-  std::vector<int> fill(g.begin.begin(), g.begin.end() - 1);
-  for (int j = 0; j < a.outerSize(); ++j)
-    for (Sparse::InnerIterator it(a, j); it; ++it)
-      if (const int r = static_cast<int>(it.row()); r > j) {
-        g.next[static_cast<std::size_t>(fill[r]++)] = j;
-        g.next[static_cast<std::size_t>(fill[j]++)] = r;
-      }
-  return g;
-}
-
-// Breadth-first levels from `start` (-1: not reached); returns how many rows were reached and
-// sets `last` to the last one reached (one of the farthest).
-int bfs_levels(const Graph& g, int start, std::vector<int>& level, int& last) {
-  std::fill(level.begin(), level.end(), -1);
-  std::vector<int> queue;
-  queue.reserve(level.size());
-  queue.push_back(start);
-  level[static_cast<std::size_t>(start)] = 0;
-  for (std::size_t head = 0; head < queue.size(); ++head) {
-    const int v = queue[head];
-    for (int k = g.begin[v]; k < g.begin[v + 1]; ++k)
-      if (const int w = g.next[static_cast<std::size_t>(k)]; level[w] < 0) {
-        level[w] = level[v] + 1;
-        queue.push_back(w);
-      }
-  }
-  last = queue.back();
-  return static_cast<int>(queue.size());
-}
-
-} // namespace
-
-LevelSeparator level_separator(const Sparse& a) {
-  const int n = static_cast<int>(a.rows());
-  if (n < 3 || a.cols() != a.rows()) return {};
-  const Graph g = adjacency(a);
-  // The largest connected component is split by a level; the others join one half whole.
-  std::vector<int> level(static_cast<std::size_t>(n), -1), queue;
-  std::vector<char> seen(level.size(), 0);
-  // Each component's breadth-first search from its first row ends at one of the rows farthest
-  // from it: the largest component's is where its levels start (a pseudo-peripheral row).
-  int far = -1, largest_size = 0, last = 0;
-  for (int v = 0; v < n; ++v) {
-    if (seen[static_cast<std::size_t>(v)]) continue;
-    queue.assign(1, v);
-    seen[static_cast<std::size_t>(v)] = 1;
-    for (std::size_t head = 0; head < queue.size(); ++head)
-      for (int k = g.begin[queue[head]]; k < g.begin[queue[head] + 1]; ++k)
-        if (const int w = g.next[static_cast<std::size_t>(k)]; !seen[static_cast<std::size_t>(w)]) {
-          seen[static_cast<std::size_t>(w)] = 1;
-          queue.push_back(w);
-        }
-    if (static_cast<int>(queue.size()) > largest_size) {
-      largest_size = static_cast<int>(queue.size());
-      far = queue.back();
-    }
-  }
-  bfs_levels(g, far, level, last);   // thin, balanced levels
-  const int rest = n - largest_size; // rows of the other components
-  const int depth = level[static_cast<std::size_t>(last)] + 1;
-  std::vector<int> count(static_cast<std::size_t>(depth), 0);
-  for (const int l : level)
-    if (l >= 0) ++count[static_cast<std::size_t>(l)];
-  // The thinnest level that balances; of equally thin ones, and of the two sides for the other
-  // components, the most balanced.
-  int best = -1, rest_side = 1, best_gap = 0;
-  for (int m = 1, below = count[0]; m + 1 < depth; below += count[m], ++m) {
-    const int above = largest_size - below - count[m];
-    for (int side = 0; side < 2; ++side) {
-      const int halves[2] = {below + (side == 0 ? rest : 0), above + (side == 1 ? rest : 0)};
-      if (std::min(halves[0], halves[1]) < 0.4 * (halves[0] + halves[1])) continue;
-      const int gap = std::abs(halves[0] - halves[1]);
-      if (best < 0 || count[m] < count[best] || (count[m] == count[best] && gap < best_gap)) {
-        best = m;
-        rest_side = side;
-        best_gap = gap;
-      }
-    }
-  }
-  if (best < 0) return {};
-  LevelSeparator s;
-  s.part.resize(static_cast<std::size_t>(n));
-  for (int v = 0; v < n; ++v) {
-    const int l = level[static_cast<std::size_t>(v)];
-    const unsigned char p = l < 0      ? static_cast<unsigned char>(rest_side)
-                            : l < best ? 0
-                            : l > best ? 1
-                                       : 2;
-    s.part[static_cast<std::size_t>(v)] = p;
-    if (p == 2)
-      ++s.separator_rows;
-    else
-      ++s.rows[p];
-  }
-  return s;
-}
-
 #ifdef REMORA_WITH_GPL_SOLVERS
 
 namespace {
+
+using Sparse = Eigen::SparseMatrix<double>;
 
 // Runs body(0) and body(1) on two threads (CHOLMOD's own OpenMP regions nested in them run on
 // one thread), and rethrows what either threw.
@@ -233,31 +117,31 @@ struct Half {
   int separator_rows() const { return size() - n; }
 
   cholmod_sparse view() {
-    cholmod_sparse m{};
-    m.nrow = m.ncol = static_cast<std::size_t>(size());
-    m.nzmax = rowind.size();
-    m.p = colptr.data();
-    m.i = rowind.data();
-    m.x = values.data();
-    m.stype = -1;
-    m.itype = CHOLMOD_INT;
-    m.xtype = CHOLMOD_REAL;
-    m.dtype = CHOLMOD_DOUBLE;
-    m.sorted = 1;
-    m.packed = 1;
-    return m;
+    return lower_view(static_cast<std::size_t>(size()), rowind.size(), colptr.data(), rowind.data(),
+                      values.data());
   }
 
-  // CAMD with the separator last, then CHOLMOD's supernodal analysis of exactly that order (no
+  // The half's rows, then the separator's, each part by CAMD or, given `keys` (one per local
+  // row), by increasing key; then CHOLMOD's supernodal analysis of exactly that order (no
   // postorder: it may move a row of the half behind the separator's). False if a row of the half
   // still ended among the trailing rows.
-  bool analyze(bool coarse) {
+  bool analyze(bool coarse, const std::vector<int>& keys) {
     cholmod_sparse m = view();
-    std::vector<int> member(static_cast<std::size_t>(size()), 1);
-    std::fill(member.begin(), member.begin() + n, 0);
     std::vector<int> perm(static_cast<std::size_t>(size()));
-    if (!cholmod_camd(&m, nullptr, 0, member.data(), perm.data(), &c))
-      throw NumericalError("cholmod: the constrained ordering failed (out of memory?)");
+    if (keys.empty()) {
+      std::vector<int> member(static_cast<std::size_t>(size()), 1);
+      std::fill(member.begin(), member.begin() + n, 0);
+      if (!cholmod_camd(&m, nullptr, 0, member.data(), perm.data(), &c))
+        throw NumericalError("cholmod: the constrained ordering failed (out of memory?)");
+    } else {
+      std::iota(perm.begin(), perm.end(), 0);
+      const auto by_key = [&](int a, int b) {
+        const int ka = keys[static_cast<std::size_t>(a)], kb = keys[static_cast<std::size_t>(b)];
+        return ka < kb || (ka == kb && a < b);
+      };
+      std::sort(perm.begin(), perm.begin() + n, by_key);
+      std::sort(perm.begin() + n, perm.end(), by_key);
+    }
     c.nmethods = 1;
     c.method[0].ordering = CHOLMOD_GIVEN;
     c.postorder = 0;
@@ -388,11 +272,19 @@ struct SplitCholesky::Impl {
 SplitCholesky::SplitCholesky() : impl_(std::make_unique<Impl>()) {}
 SplitCholesky::~SplitCholesky() = default;
 
-bool SplitCholesky::analyze(const Sparse& a, int max_separator_rows, bool coarse_supernodes) {
+bool SplitCholesky::analyze(const Sparse& a, int max_separator_rows, bool coarse_supernodes,
+                            const std::vector<int>& keys) {
   impl_ = std::make_unique<Impl>();
   Impl& m = *impl_;
   if (!a.isCompressed()) return false;
-  const LevelSeparator split = level_separator(a);
+  if (!keys.empty() && static_cast<Eigen::Index>(keys.size()) != a.rows())
+    throw InvalidArgument("cholmod: " + std::to_string(keys.size()) + " order keys for " +
+                          std::to_string(a.rows()) + " rows; give one per row or none");
+  Separator split = keys.empty() ? Separator{} : tree_separator(a, keys);
+  if (split.part.empty() || split.separator_rows > max_separator_rows) {
+    split = level_separator(a);
+    split.keys = keys;
+  }
   if (split.part.empty() || split.separator_rows > max_separator_rows) return false;
   m.n = a.rows();
   m.nonzeros = a.nonZeros();
@@ -422,7 +314,17 @@ bool SplitCholesky::analyze(const Sparse& a, int max_separator_rows, bool coarse
   bool ordered[2] = {false, false};
   on_both_halves([&](int i) {
     m.build_half(a, local, i);
-    ordered[i] = m.half[i].analyze(coarse_supernodes);
+    std::vector<int> half_keys;
+    if (const std::vector<int>& order = split.keys; !order.empty()) {
+      const Half& h = m.half[i];
+      half_keys.resize(static_cast<std::size_t>(h.size()));
+      for (int l = 0; l < h.n; ++l)
+        half_keys[static_cast<std::size_t>(l)] = order[static_cast<std::size_t>(h.rows[l])];
+      for (std::size_t r = 0; r < m.separator.size(); ++r)
+        half_keys[static_cast<std::size_t>(h.n) + r] =
+            order[static_cast<std::size_t>(m.separator[r])];
+    }
+    ordered[i] = m.half[i].analyze(coarse_supernodes, half_keys);
   });
   if (!ordered[0] || !ordered[1]) {
     impl_ = std::make_unique<Impl>();

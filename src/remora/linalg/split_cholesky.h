@@ -13,8 +13,8 @@
 // forward sweep of each half, the dense solve of S, and a backward sweep of each half, the halves
 // on two threads. The result is that of one factorization of K to round-off.
 //
-// SplitCholesky exists only in builds with the GPL solvers (CHOLMOD); level_separator in every
-// build. Not thread-safe: one object per thread.
+// SplitCholesky exists only in builds with the GPL solvers (CHOLMOD); its separators
+// (separator.h) in every build. Not thread-safe: one object per thread.
 #pragma once
 
 #include <cstddef>
@@ -24,20 +24,9 @@
 #include <Eigen/Dense>
 #include <Eigen/SparseCore>
 
+#include "remora/linalg/separator.h"
+
 namespace remora {
-
-/// The rows of a symmetric pattern split by one level of a breadth-first search: part[i] is 0 or
-/// 1 for the two halves, 2 for the separator. Rows of part 0 and part 1 are never coupled.
-struct LevelSeparator {
-  std::vector<unsigned char> part;
-  int separator_rows = 0;
-  int rows[2] = {0, 0};
-};
-
-/// The separator level whose halves are balanced within [0.4, 0.6] of the rest and which has the
-/// fewest rows, read from the lower triangle of `a` (n × n). The largest connected component is
-/// cut; the others join one half whole. Empty `part` when no level balances the halves.
-LevelSeparator level_separator(const Eigen::SparseMatrix<double>& a);
 
 class SplitCholesky {
 public:
@@ -48,10 +37,13 @@ public:
 
   /// Splits the symmetric pattern of `a` (compressed; lower triangle read) and analyses both
   /// halves, with coarser supernodes than CHOLMOD's defaults when `coarse_supernodes`
-  /// (solver.cpp). Returns false, keeping nothing, when `a` is not compressed or no separator of
-  /// at most `max_separator_rows` rows balances the graph; the caller then factors `a` as one.
-  bool analyze(const Eigen::SparseMatrix<double>& a, int max_separator_rows,
-               bool coarse_supernodes);
+  /// (solver.cpp). Each half's rows, then the separator's, are ordered by CAMD, or by increasing
+  /// `keys` (one per row of `a`; ties by row) when given (Solver::set_order_keys). Returns false,
+  /// keeping nothing, when `a` is not compressed or no separator of at most `max_separator_rows`
+  /// rows balances the graph; the caller then factors `a` as one. Throws InvalidArgument when
+  /// `keys` is neither empty nor one per row.
+  bool analyze(const Eigen::SparseMatrix<double>& a, int max_separator_rows, bool coarse_supernodes,
+               const std::vector<int>& keys = {});
   /// The numbers of `a`, which has the pattern given to analyze(). Returns false when `a` is not
   /// positive definite; throws NumericalError when CHOLMOD fails otherwise (out of memory), and
   /// InvalidArgument for another pattern.

@@ -2,12 +2,14 @@
 // vertices, and the fallback to the full preprocess.
 #include "remora/multires/bake.h"
 
+#include <algorithm>
 #include <cmath>
 #include <ctime>
 #include <functional>
 #include <future>
 #include <queue>
 #include <utility>
+#include <vector>
 
 #include <fmt/format.h>
 
@@ -123,6 +125,33 @@ void update_assembler(const Bake& b, const SpliceMap* map, EditorParts& parts) {
   parts.assembler.emplace(parts.base, b.old.assembler, previous_of, changed, b.options.threads);
 }
 
+// The old base's nested-dissection order (Editor::order_base) carried over: a vertex of the old
+// base keeps its key (the order depends on the graph only, and moving a vertex keeps its edges),
+// a patch vertex takes the key of the nearest one that has a key (breadth first). The order then
+// differs from a new one only inside the patch.
+void carry_order(const Bake& b, const SpliceMap* map, EditorParts& parts) {
+  if (b.old.base_order.empty()) return;
+  const std::size_t n = parts.base.n_vertices();
+  std::vector<int> keys(n, -1), queue;
+  for (std::size_t o = 0; o < b.old.base_order.size(); ++o) {
+    const int v = map ? map->vertices[o] : static_cast<int>(o);
+    if (v < 0) continue;
+    keys[static_cast<std::size_t>(v)] = b.old.base_order[o];
+    queue.push_back(v);
+  }
+  for (std::size_t head = 0; head < queue.size(); ++head) {
+    const int v = queue[head];
+    for (const VertexHandle w : parts.base.vv_range(VertexHandle(v)))
+      if (keys[static_cast<std::size_t>(w.idx())] < 0) {
+        keys[static_cast<std::size_t>(w.idx())] = keys[static_cast<std::size_t>(v)];
+        queue.push_back(w.idx());
+      }
+  }
+  for (int& k : keys) k = std::max(k, 0); // a component with no old vertex
+  parts.base_order = std::move(keys);
+  parts.base_order_k = b.old.base_order_k;
+}
+
 // B's vertex normals: the old ones renumbered, and measured again (update_vertex_normals(), the
 // same bits as vertex_normals()) around every face that is new, has a moved corner or changed
 // its index, which could change the order of a vertex's faces and so its sum.
@@ -194,6 +223,7 @@ void finish(Bake& b, const PatchMeshes* meshes, const RemeshPatchResult* remeshe
   auto job = std::async(b.options.threads == 1 ? std::launch::deferred : std::launch::async, [&] {
     const auto t0 = Clock::now();
     update_assembler(b, map, parts);
+    carry_order(b, map, parts);
     figures = update_vertex_figures(b.old.statistics, parts.base, change, *parts.assembler,
                                     parts.statistics, b.options.threads);
     assembler_ms = ms_since(t0);
@@ -292,6 +322,11 @@ BakeResult bake(Editor& editor, const BakeOptions& options) {
   full.fallback = reason;
   full.changed_vertices = report.changed_vertices;
   Editor baked(editor.result(), editor.options());
+  if (!editor.parts().base_order.empty()) { // ordered afresh, as the old base was
+    const auto t1 = Clock::now();
+    baked.order_base();
+    full.milliseconds["order"] = ms_since(t1);
+  }
   full.milliseconds["total"] = ms_since(t0);
   return {std::move(baked), std::move(full)};
 }

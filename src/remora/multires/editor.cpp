@@ -17,6 +17,7 @@
 #include "remora/common/timer.h"
 #include "remora/geometry/laplacian.h"
 #include "remora/geometry/measures.h"
+#include "remora/linalg/nested_dissection.h"
 #include "remora/multires/editor_detail.h"
 
 namespace remora {
@@ -199,6 +200,19 @@ const std::vector<int>& Editor::movable_vertices() const {
   return impl_->region ? impl_->region->encoded : none;
 }
 
+void Editor::order_base() {
+  Impl& m = *impl_;
+  const int k = m.options.system.k;
+  if ((!m.base_order.empty() && m.base_order_k == k) ||
+      m.solver_name(m.options.system.areas != AreaWeights::Mixed) != "cholmod" ||
+      m.options.solver.ordering != "amd" || m.base.n_vertices() > kMaxOrderedBaseVertices)
+    return;
+  std::vector<int> keys = nested_dissection_keys(ring_pattern(m.assembler->minus_w(), k));
+  if (keys.empty()) return;
+  m.base_order = std::move(keys);
+  m.base_order_k = k;
+}
+
 void Editor::set_system(const KHarmonicOptions& system) {
   EditorOptions o = impl_->options;
   o.system = system;
@@ -359,7 +373,8 @@ EditorPartsView Editor::parts() const {
   const Impl& m = *impl_;
   return {m.input,          m.input_positions, m.input_topology, m.filter,        m.smooth,
           m.base,           m.topology,        m.base_rest,      m.base_on_input, m.input_on_base,
-          m.negative_edges, m.statistics,      m.report,         *m.assembler,    m.base_normals};
+          m.negative_edges, m.statistics,      m.report,         *m.assembler,    m.base_normals,
+          m.base_order,     m.base_order_k};
 }
 
 nlohmann::json to_json(const EditReport& r) {
@@ -391,7 +406,8 @@ nlohmann::json to_json(const EditReport& r) {
                  {"iterations", r.solver_stats.iterations},
                  {"residual", r.solver_stats.residual},
                  {"factor_bytes", r.solver_stats.factor_bytes},
-                 {"separator_rows", r.solver_stats.separator_rows}};
+                 {"separator_rows", r.solver_stats.separator_rows},
+                 {"keyed_order", r.solver_stats.keyed_order}};
   j["phong"] = {{"encoded", r.phong.encoded},
                 {"walk_steps", r.phong.walk_steps},
                 {"extrapolated", r.phong.extrapolated},

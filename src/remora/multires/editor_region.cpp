@@ -245,6 +245,12 @@ void Editor::Impl::solve_basis(RegionState& r, EditReport& out, const std::stop_
       so.name = name;
       if (so.threads == 0) so.threads = options.threads;
       const std::unique_ptr<Solver> solver = make_solver(so);
+      if (!base_order.empty() && base_order_k == options.system.k) {
+        std::vector<int> keys(system.free_vertices.size());
+        for (std::size_t row = 0; row < keys.size(); ++row)
+          keys[row] = base_order[static_cast<std::size_t>(system.free_vertices[row])];
+        solver->set_order_keys(std::move(keys));
+      }
       if (stop.stop_requested()) return;
       solver->compute(system.matrix);
       out.milliseconds["factor"] = ms_since(t0);
