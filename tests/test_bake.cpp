@@ -263,14 +263,15 @@ TEST(Bake, MatchesAFullPreprocessAndKeepsTheRestBitForBit) {
 }
 
 #ifdef REMORA_WITH_GPL_SOLVERS
-// Editor::order_base: regions' factors follow the base's nested dissection and solve as CAMD's
-// halves do; a bake carries the order over to the new base, and the next regions follow it.
+// Editor::prepare_regions: regions' systems come from the kept rows and their factors follow the
+// base's nested dissection, with the results of an unprepared editor; a bake prepares the new
+// editor, carrying the order over, and the next regions follow it.
 TEST(Bake, CarriesTheBasesOrderAndTheRegionsFollowIt) {
   const Mesh bunny = read_mesh(std::string(REMORA_REPO_DATA) + "/bunny.ply").mesh;
   const VertexHandle back = nearest_vertex(bunny, Vec3(-0.03, 0.12, -0.03));
   const double diagonal = bounding_box_diagonal(bunny);
   Editor ordered(bunny, two_threads()), plain(bunny, two_threads());
-  ordered.order_base();
+  ordered.prepare_regions();
   const EditorPartsView p = ordered.parts();
   ASSERT_EQ(p.base_order.size(), ordered.base().n_vertices());
   EXPECT_EQ(p.base_order_k, 2);
@@ -278,6 +279,8 @@ TEST(Bake, CarriesTheBasesOrderAndTheRegionsFollowIt) {
   std::sort(sorted.begin(), sorted.end());
   for (std::size_t k = 0; k < sorted.size(); ++k) ASSERT_EQ(sorted[k], static_cast<int>(k));
   EXPECT_TRUE(plain.parts().base_order.empty());
+  EXPECT_GT(p.assembler.kept_row_bytes(), 0u);
+  EXPECT_EQ(plain.parts().assembler.kept_row_bytes(), 0u);
   const BakeRegion large = region(bunny, back, 20000);
   Eigen::MatrixXd moved[2];
   Editor* editors[2] = {&ordered, &plain};
@@ -300,6 +303,7 @@ TEST(Bake, CarriesTheBasesOrderAndTheRegionsFollowIt) {
   const EditorPartsView q = baked.editor.parts();
   ASSERT_EQ(q.base_order.size(), baked.editor.base().n_vertices());
   EXPECT_EQ(q.base_order_k, 2);
+  EXPECT_GT(q.assembler.kept_row_bytes(), 0u); // prepared as the old editor was
   for (const int key : q.base_order) ASSERT_TRUE(key >= 0 && key < static_cast<int>(sorted.size()));
   baked.editor.set_region(large.support, {large.handle});
   EXPECT_TRUE(baked.editor.report().solver_stats.keyed_order);

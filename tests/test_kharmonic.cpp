@@ -4,6 +4,7 @@
 // factorization from ever meeting a singular matrix.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -247,6 +248,43 @@ TEST(KHarmonic, TheAssemblerBuildsTheRowsOfTheDefinition) {
         }
       }
   }
+}
+
+// keep_rows(): a region's system copied out of the kept rows is the one multiplied out, bit for
+// bit, for every k and weighting; the rows of another k or weighting are multiplied out as before.
+TEST(KHarmonic, KeptRowsGiveTheSameSystemsBitForBit) {
+  const Mesh mesh = make_icosphere(4);
+  const KHarmonicAssembler plain(mesh);
+  KHarmonicAssembler kept(mesh);
+  EXPECT_EQ(kept.kept_row_bytes(), 0u);
+  Region region{std::vector<int>(mesh.n_vertices(), Region::kFree)};
+  for (auto v : mesh.vertices()) {
+    const double z = mesh.point(v)[2];
+    if (z > 0.6) region.label[static_cast<std::size_t>(v.idx())] = 0;
+    if (z < -0.2) region.label[static_cast<std::size_t>(v.idx())] = Region::kFixed;
+  }
+  const auto same = [](const SparseMatrix& x, const SparseMatrix& y) {
+    return x.rows() == y.rows() && x.cols() == y.cols() && x.nonZeros() == y.nonZeros() &&
+           std::equal(x.outerIndexPtr(), x.outerIndexPtr() + x.outerSize() + 1,
+                      y.outerIndexPtr()) &&
+           std::equal(x.innerIndexPtr(), x.innerIndexPtr() + x.nonZeros(), y.innerIndexPtr()) &&
+           std::equal(x.valuePtr(), x.valuePtr() + x.nonZeros(), y.valuePtr());
+  };
+  for (int k = 1; k <= 3; ++k)
+    for (AreaWeights w : {AreaWeights::Mixed, AreaWeights::Mean, AreaWeights::MixedSymmetric}) {
+      SCOPED_TRACE(::testing::Message() << "k " << k << " " << to_string(w));
+      kept.keep_rows({.k = k, .areas = w});
+      EXPECT_GT(kept.kept_row_bytes(), 0u);
+      for (const int other_k : {1, 2, 3}) { // the kept rows' k, and others multiplied out
+        const KHarmonicSystem a = plain.assemble(region, {.k = other_k, .areas = w});
+        const KHarmonicSystem b = kept.assemble(region, {.k = other_k, .areas = w});
+        EXPECT_TRUE(same(a.matrix, b.matrix)) << "k " << other_k;
+        EXPECT_TRUE(same(a.coupling, b.coupling)) << "k " << other_k;
+        EXPECT_EQ(a.constrained_vertices, b.constrained_vertices);
+        EXPECT_EQ(a.free_vertices, b.free_vertices);
+      }
+    }
+  EXPECT_THROW(kept.keep_rows({.k = 4}), InvalidArgument);
 }
 
 TEST(KHarmonic, ClearErrorsInsteadOfSingularSystems) {

@@ -355,7 +355,7 @@ TEST(SplitCholesky, TheSeparatorDecouplesTwoBalancedHalves) {
 
 #ifdef REMORA_WITH_GPL_SOLVERS
 // The base's order (nested_dissection.h) of a region: the rows of one mesh-wide order, as the
-// editor gives them (Editor::order_base). Its tree separator cuts the region into halves that do
+// editor gives them (Editor::prepare_regions). Its tree separator cuts the region into halves that do
 // not couple, thinner than a breadth-first level, and its keys are a postorder of the tree.
 TEST(SplitCholesky, TheTreeOfANestedDissectionGivesAThinSeparator) {
   const Mesh mesh = make_icosphere(5);

@@ -288,7 +288,7 @@ struct Session::Impl {
     std::optional<Editor::Prepared> prepared;
     try {
       editor.set_system({key.k, previous_system.areas});
-      editor.order_base(); // for a new k (the load job ordered the base for the first)
+      editor.prepare_regions(); // for a new k (the load job prepared the first)
       editor.set_method(key.method);
       editor.set_nonlinear_energy(key.energy);
       if (work.new_region) prepared = editor.prepare_region(key.support, key.handles, token);
@@ -395,8 +395,9 @@ void Session::start_load(std::string bytes, std::string name) {
     auto box = std::make_shared<EditorBox>(Editor(std::move(loaded.mesh), m.editor_options()));
     // The first regions' factors then find warm pages (common/memory.h).
     warm_heap(warm_heap_bytes(box->editor.base().n_vertices(), box->editor.options().system.k));
-    // The regions' factors then follow one order of the base (docs/solvers.md).
-    box->editor.order_base();
+    // The regions' systems then come from one set of rows and their factors follow one order of
+    // the base (docs/solvers.md).
+    box->editor.prepare_regions();
     box->preprocess_ms = ms_since(t0);
     std::lock_guard guard(m.mutex);
     m.box = box;

@@ -228,15 +228,16 @@ class Editor:
         """Changes k and the area weights for the next :meth:`set_region`."""
         self._editor.set_system(k, areas)
 
-    def order_base(self) -> None:
-        """Orders the base once for the factors of the regions to come: a nested dissection of
-        its graph (METIS) for the current k, which each large region's factor then follows
-        instead of ordering its own rows (docs/solvers.md). Worth its cost (about a quarter of a
-        second on the bunny) before many regions; does nothing without the GPL solvers, with
-        another solver than "cholmod" (amd), or on a base of more than 200,000 vertices. The
-        results are those of an unordered editor to round-off; ``report()["solver"]
-        ["keyed_order"]`` says whether a region followed the order."""
-        self._editor.order_base()
+    def prepare_regions(self) -> None:
+        """Precomputes, once, what the regions to come share: the rows of the base's operator
+        for the current k (each :meth:`set_region` then copies its system out of them) and, with
+        the "cholmod" solver, a nested dissection of the base (METIS), which each large region's
+        factor follows instead of ordering its own rows (docs/solvers.md). Worth its cost (about
+        a quarter of a second on the bunny) before many regions; does nothing on a base of more
+        than 200,000 vertices. The results are those of an unprepared editor to round-off;
+        ``report()["solver"]["keyed_order"]`` says whether a region's factor followed the
+        order."""
+        self._editor.prepare_regions()
 
     def report(self) -> dict:
         """Figures and timings (docs/editing.md, "The report"): sizes of the input and base,

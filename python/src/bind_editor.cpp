@@ -278,8 +278,8 @@ public:
     locked([&] { editor_->set_system(system); });
   }
 
-  void order_base() {
-    locked([&] { editor_->order_base(); });
+  void prepare_regions() {
+    locked([&] { editor_->prepare_regions(); });
   }
 
   int handle_count() {
@@ -336,7 +336,7 @@ void bind_editor(py::module_& m) {
       .def("base_positions", &PyEditor::base_positions)
       .def("low_pass", &PyEditor::low_pass, py::arg("values"))
       .def("set_system", &PyEditor::set_system, py::arg("k"), py::arg("areas"))
-      .def("order_base", &PyEditor::order_base)
+      .def("prepare_regions", &PyEditor::prepare_regions)
       .def("handle_count", &PyEditor::handle_count)
       .def("movable_vertices", &PyEditor::movable_vertices)
       .def("handle_center", &PyEditor::handle_center, py::arg("handle"))

@@ -149,7 +149,7 @@ def test_higher_k_bends_wider(bunny, bunny_editor):
     assert lift[1] < lift[2] < lift[3]
 
 
-def test_an_ordered_base_solves_as_an_unordered_one(bunny):
+def test_a_prepared_editor_solves_as_an_unprepared_one(bunny):
     # A region of about 19,000 free base vertices: factored in two halves, which follow the
     # base's order once it exists. The result is the same to round-off.
     support = np.flatnonzero(bunny.V[:, 1] > 0.075)
@@ -159,7 +159,7 @@ def test_an_ordered_base_solves_as_an_unordered_one(bunny):
     for ordered in (False, True):
         editor = remora.Editor(bunny.V, bunny.F)
         if ordered:
-            editor.order_base()
+            editor.prepare_regions()
         editor.set_region(support, [handle])
         editor.set_transform(0, T)
         moved.append(editor.positions())

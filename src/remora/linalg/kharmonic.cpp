@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <future>
+#include <memory>
+#include <numeric>
 #include <string>
 
 #include "remora/common/error.h"
@@ -11,6 +13,27 @@
 #include "remora/mesh/topology.h"
 
 namespace remora {
+
+// Named, not anonymous: KHarmonicAssembler::KeptRows holds it (GCC's -Wsubobject-linkage in unity
+// builds).
+namespace kharmonic_detail {
+
+// Rows of the system, as (vertex, value) lists in vertex order without the zero sums: row i's
+// entries are [start[i], start[i + 1]).
+struct RowBlock {
+  std::vector<int> start{0}, vertex;
+  std::vector<double> value;
+};
+
+} // namespace kharmonic_detail
+
+using kharmonic_detail::RowBlock;
+
+struct KHarmonicAssembler::KeptRows {
+  int k = 0;
+  bool scaled = false; // the inner areas S = A⁻¹ (MixedSymmetric, Mixed) or none (Mean)
+  RowBlock rows;       // row v is vertex v's, without the Mixed system's row scaling
+};
 
 namespace {
 
@@ -94,13 +117,6 @@ void power_row(const SparseMatrix& minus_w, const Eigen::VectorXd* scale, int k,
   inner.clear();
 }
 
-// The free rows of one block, as (vertex, value) lists in vertex order without the zero sums;
-// `mixed_scale` scales each row by its vertex's inverse area (the Mixed system).
-struct RowBlock {
-  std::vector<int> start{0}, vertex;
-  std::vector<double> value;
-};
-
 RowBlock power_rows(const SparseMatrix& minus_w, const Eigen::VectorXd* scale, int k,
                     const Eigen::VectorXd* mixed_scale, const std::vector<int>& free_vertices,
                     std::size_t begin, std::size_t end) {
@@ -124,52 +140,94 @@ RowBlock power_rows(const SparseMatrix& minus_w, const Eigen::VectorXd* scale, i
   return block;
 }
 
+// The rows of `vertices` (in that order) as blocks of consecutive rows, built on `threads`
+// threads; `mixed_scale` scales each row by its vertex's inverse area (the Mixed system).
+std::vector<RowBlock> power_rows_in_blocks(const SparseMatrix& minus_w, int threads,
+                                           const std::vector<int>& vertices,
+                                           const Eigen::VectorXd* scale, int k,
+                                           const Eigen::VectorXd* mixed_scale) {
+  const std::size_t count_rows = vertices.size();
+  const int team = threads > 0 ? threads : omp_get_max_threads();
+  const std::size_t count = count_rows < 4096 ? 1 : static_cast<std::size_t>(4 * team);
+  std::vector<RowBlock> blocks(count);
+  parallel_blocks(count, threads, [&](std::size_t b) {
+    blocks[b] = power_rows(minus_w, scale, k, mixed_scale, vertices, b * count_rows / count,
+                           (b + 1) * count_rows / count);
+  });
+  return blocks;
+}
+
+// A free row as the split reads it: its entries (vertex, value) in vertex order, each value
+// multiplied by `scale` (the Mixed system's inverse area when the row was kept unscaled).
+struct RowView {
+  const int* vertex;
+  const double* value;
+  int size;
+  double scale;
+};
+
 // Splits the rows by column into system.matrix (free columns, by row_of) and system.coupling
-// (constrained columns, numbered in vertex order into system.constrained_vertices).
-void split_columns(const std::vector<RowBlock>& blocks, std::size_t n, KHarmonicSystem& system) {
+// (constrained columns, numbered in vertex order into system.constrained_vertices): the rows
+// counted and filled on `threads` threads.
+void split_columns(const std::vector<RowView>& rows, std::size_t n, KHarmonicSystem& system,
+                   int threads) {
   std::vector<int> column_of(n, -1);
-  for (const RowBlock& b : blocks)
-    for (const int j : b.vertex)
-      if (system.row_of[static_cast<std::size_t>(j)] < 0)
-        column_of[static_cast<std::size_t>(j)] = 0;
+  for (const RowView& row : rows)
+    for (int e = 0; e < row.size; ++e)
+      if (system.row_of[static_cast<std::size_t>(row.vertex[e])] < 0)
+        column_of[static_cast<std::size_t>(row.vertex[e])] = 0;
   for (std::size_t v = 0; v < n; ++v)
     if (column_of[v] >= 0) {
       column_of[v] = static_cast<int>(system.constrained_vertices.size());
       system.constrained_vertices.push_back(static_cast<int>(v));
     }
-  const auto nf = static_cast<Eigen::Index>(system.free_vertices.size());
-  const auto nc = static_cast<Eigen::Index>(system.constrained_vertices.size());
+  const std::size_t nf = rows.size();
+  std::vector<int> free_start(nf + 1, 0), constrained_start(nf + 1, 0);
+  parallel_for_static(nf, threads, [&](std::size_t r) {
+    int free = 0;
+    for (int e = 0; e < rows[r].size; ++e)
+      free += system.row_of[static_cast<std::size_t>(rows[r].vertex[e])] >= 0;
+    free_start[r + 1] = free;
+    constrained_start[r + 1] = rows[r].size - free;
+  });
+  for (std::size_t r = 0; r < nf; ++r) {
+    free_start[r + 1] += free_start[r];
+    constrained_start[r + 1] += constrained_start[r];
+  }
   // Both numberings follow the vertex order, so each row's entries come out sorted.
-  std::vector<int> free_start{0}, constrained_start{0}, free_column, constrained_column;
-  std::vector<double> free_value, constrained_value;
-  for (const RowBlock& b : blocks)
-    for (std::size_t r = 0; r + 1 < b.start.size(); ++r) {
-      for (auto e = static_cast<std::size_t>(b.start[r]);
-           e < static_cast<std::size_t>(b.start[r + 1]); ++e) {
-        const auto j = static_cast<std::size_t>(b.vertex[e]);
-        if (system.row_of[j] >= 0) {
-          free_column.push_back(system.row_of[j]);
-          free_value.push_back(b.value[e]);
-        } else {
-          constrained_column.push_back(column_of[j]);
-          constrained_value.push_back(b.value[e]);
-        }
+  std::vector<int> free_column(static_cast<std::size_t>(free_start[nf])),
+      constrained_column(static_cast<std::size_t>(constrained_start[nf]));
+  std::vector<double> free_value(free_column.size()), constrained_value(constrained_column.size());
+  parallel_for_static(nf, threads, [&](std::size_t r) {
+    const RowView& row = rows[r];
+    auto f = static_cast<std::size_t>(free_start[r]),
+         c = static_cast<std::size_t>(constrained_start[r]);
+    for (int e = 0; e < row.size; ++e) {
+      const auto j = static_cast<std::size_t>(row.vertex[e]);
+      const double x = row.scale == 1.0 ? row.value[e] : row.value[e] * row.scale;
+      if (system.row_of[j] >= 0) {
+        free_column[f] = system.row_of[j];
+        free_value[f++] = x;
+      } else {
+        constrained_column[c] = column_of[j];
+        constrained_value[c++] = x;
       }
-      free_start.push_back(static_cast<int>(free_column.size()));
-      constrained_start.push_back(static_cast<int>(constrained_column.size()));
     }
+  });
+  const auto rows_count = static_cast<Eigen::Index>(nf);
+  const auto nc = static_cast<Eigen::Index>(system.constrained_vertices.size());
   // A symmetric matrix is its own transpose: its row-major arrays are its column-major ones.
   if (system.symmetric) {
-    system.matrix =
-        Eigen::Map<const SparseMatrix>(nf, nf, static_cast<Eigen::Index>(free_value.size()),
-                                       free_start.data(), free_column.data(), free_value.data());
+    system.matrix = Eigen::Map<const SparseMatrix>(
+        rows_count, rows_count, static_cast<Eigen::Index>(free_value.size()), free_start.data(),
+        free_column.data(), free_value.data());
   } else {
-    system.matrix =
-        Eigen::Map<const RowMatrix>(nf, nf, static_cast<Eigen::Index>(free_value.size()),
-                                    free_start.data(), free_column.data(), free_value.data());
+    system.matrix = Eigen::Map<const RowMatrix>(
+        rows_count, rows_count, static_cast<Eigen::Index>(free_value.size()), free_start.data(),
+        free_column.data(), free_value.data());
   }
   const Eigen::Map<const RowMatrix> coupling(
-      nf, nc, static_cast<Eigen::Index>(constrained_value.size()), constrained_start.data(),
+      rows_count, nc, static_cast<Eigen::Index>(constrained_value.size()), constrained_start.data(),
       constrained_column.data(), constrained_value.data());
   system.coupling = coupling;
 }
@@ -252,14 +310,26 @@ KHarmonicSystem KHarmonicAssembler::assemble(const Region& region,
   const Eigen::VectorXd* scale = options.areas == AreaWeights::Mean ? nullptr : &inverse_area_;
   const Eigen::VectorXd* mixed = options.areas == AreaWeights::Mixed ? &inverse_area_ : nullptr;
   const std::size_t nf = system.free_vertices.size();
-  const int team = threads_ > 0 ? threads_ : omp_get_max_threads();
-  const std::size_t count = nf < 4096 ? 1 : static_cast<std::size_t>(4 * team);
-  std::vector<RowBlock> blocks(count);
-  parallel_blocks(count, threads_, [&](std::size_t b) {
-    blocks[b] = power_rows(minus_w_, scale, options.k, mixed, system.free_vertices, b * nf / count,
-                           (b + 1) * nf / count);
-  });
-  split_columns(blocks, n, system);
+  std::vector<RowView> rows(nf);
+  std::vector<RowBlock> blocks;
+  if (kept_ && kept_->k == options.k && kept_->scaled == (scale != nullptr)) {
+    const RowBlock& all = kept_->rows; // row v is vertex v's, unscaled for Mixed
+    parallel_for_static(nf, threads_, [&](std::size_t r) {
+      const auto v = static_cast<std::size_t>(system.free_vertices[r]);
+      const int begin = all.start[v];
+      rows[r] = {all.vertex.data() + begin, all.value.data() + begin, all.start[v + 1] - begin,
+                 mixed ? (*mixed)[static_cast<Eigen::Index>(v)] : 1.0};
+    });
+  } else {
+    blocks =
+        power_rows_in_blocks(minus_w_, threads_, system.free_vertices, scale, options.k, mixed);
+    for (std::size_t b = 0, r = 0; b < blocks.size(); ++b)
+      for (std::size_t i = 0; i + 1 < blocks[b].start.size(); ++i, ++r)
+        rows[r] = {blocks[b].vertex.data() + blocks[b].start[i],
+                   blocks[b].value.data() + blocks[b].start[i],
+                   blocks[b].start[i + 1] - blocks[b].start[i], 1.0};
+  }
+  split_columns(rows, n, system, threads_);
   if (system.symmetric && options.k == 3) {
     // k = 3 sums its products in another order for (i, j) than for (j, i): symmetric to
     // round-off only.
@@ -269,6 +339,35 @@ KHarmonicSystem KHarmonicAssembler::assemble(const Region& region,
   system.matrix.makeCompressed();
   system.coupling.makeCompressed();
   return system;
+}
+
+void KHarmonicAssembler::keep_rows(const KHarmonicOptions& options) {
+  if (options.k < 1 || options.k > 3)
+    throw InvalidArgument("k-harmonic rows: k = " + std::to_string(options.k) +
+                          " is not supported; use 1, 2 or 3");
+  const bool scaled = options.areas != AreaWeights::Mean;
+  if (kept_ && kept_->k == options.k && kept_->scaled == scaled) return;
+  std::vector<int> all(vertex_count());
+  std::iota(all.begin(), all.end(), 0);
+  const std::vector<RowBlock> blocks = power_rows_in_blocks(
+      minus_w_, threads_, all, scaled ? &inverse_area_ : nullptr, options.k, nullptr);
+  auto kept = std::make_shared<KeptRows>();
+  kept->k = options.k;
+  kept->scaled = scaled;
+  RowBlock& rows = kept->rows;
+  for (const RowBlock& b : blocks) {
+    const int shift = rows.start.back();
+    for (std::size_t i = 1; i < b.start.size(); ++i) rows.start.push_back(b.start[i] + shift);
+    rows.vertex.insert(rows.vertex.end(), b.vertex.begin(), b.vertex.end());
+    rows.value.insert(rows.value.end(), b.value.begin(), b.value.end());
+  }
+  kept_ = std::move(kept);
+}
+
+std::size_t KHarmonicAssembler::kept_row_bytes() const {
+  if (!kept_) return 0;
+  return kept_->rows.start.size() * sizeof(int) +
+         kept_->rows.vertex.size() * (sizeof(int) + sizeof(double));
 }
 
 int Region::handle_count() const {

@@ -23,6 +23,7 @@
 // energy xᵀ W A⁻¹ W x over the free vertices, again with natural conditions at the boundary.
 #pragma once
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -106,6 +107,16 @@ public:
   /// handle.
   KHarmonicSystem assemble(const Region& region, const KHarmonicOptions& options = {}) const;
 
+  /// Computes and keeps the rows of every vertex for `options`' k and area weighting (about 12
+  /// bytes per entry: a 2-ring stencil per vertex for k = 2): later assemble() calls with the
+  /// same k and weighting copy their free rows instead of multiplying them out, the same numbers
+  /// bit for bit. Another k or weighting is assembled as before, and keep_rows() for it replaces
+  /// the kept rows. For an editor that sets many regions on one base (Editor::prepare_regions).
+  /// Throws InvalidArgument for a k other than 1, 2, 3.
+  void keep_rows(const KHarmonicOptions& options);
+  /// The memory of the kept rows (0 without).
+  std::size_t kept_row_bytes() const;
+
   std::size_t vertex_count() const { return static_cast<std::size_t>(offsets_.size() - 1); }
   /// −W (column-major, symmetric).
   const SparseMatrix& minus_w() const { return minus_w_; }
@@ -125,6 +136,8 @@ private:
   std::vector<int> component_;          // connected component of every vertex
   int components_ = 0;
   int threads_ = 0;
+  struct KeptRows;                       // keep_rows() (kharmonic.cpp)
+  std::shared_ptr<const KeptRows> kept_; // shared by copies: the rows depend on the mesh alone
 };
 
 /// KHarmonicAssembler(mesh).assemble(region, options): one region's system.

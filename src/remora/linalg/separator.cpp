@@ -149,7 +149,6 @@ std::vector<int> elimination_tree(const Graph& g, const std::vector<int>& order,
   return parent;
 }
 
-
 // The rows by increasing key, ties by row: counted when the keys are small (a base's order), else
 // sorted.
 std::vector<int> sorted_by_key(const std::vector<int>& keys) {
@@ -161,7 +160,8 @@ std::vector<int> sorted_by_key(const std::vector<int>& keys) {
     for (const int k : keys) ++start[static_cast<std::size_t>(k) + 1];
     for (std::size_t k = 1; k < start.size(); ++k) start[k] += start[k - 1];
     for (int v = 0; v < n; ++v)
-      order[static_cast<std::size_t>(start[static_cast<std::size_t>(keys[static_cast<std::size_t>(v)])]++)] = v;
+      order[static_cast<std::size_t>(
+          start[static_cast<std::size_t>(keys[static_cast<std::size_t>(v)])]++)] = v;
   } else {
     std::iota(order.begin(), order.end(), 0);
     std::sort(order.begin(), order.end(), [&](int x, int y) {

@@ -125,7 +125,7 @@ void update_assembler(const Bake& b, const SpliceMap* map, EditorParts& parts) {
   parts.assembler.emplace(parts.base, b.old.assembler, previous_of, changed, b.options.threads);
 }
 
-// The old base's nested-dissection order (Editor::order_base) carried over: a vertex of the old
+// The old base's nested-dissection order (Editor::prepare_regions) carried over: a vertex of the old
 // base keeps its key (the order depends on the graph only, and moving a vertex keeps its edges),
 // a patch vertex takes the key of the nearest one that has a key (breadth first). The order then
 // differs from a new one only inside the patch.
@@ -284,6 +284,17 @@ void local_parts(const Editor& editor, const Eigen::MatrixXd& positions,
 }
 
 } // namespace
+
+// The new editor prepared for regions (Editor::prepare_regions) when the old one was: its rows
+// computed, its order carried over (carry_order) or, after a full re-preprocess, computed.
+void prepare_like(Editor& old, Editor& baked, BakeReport& report) {
+  const EditorPartsView p = old.parts();
+  if (p.assembler.kept_row_bytes() == 0 && p.base_order.empty()) return;
+  const auto t0 = Clock::now();
+  baked.prepare_regions();
+  report.milliseconds["prepare regions"] = ms_since(t0);
+}
+
 } // namespace bake_detail
 
 BakeResult bake(Editor& editor, const BakeOptions& options) {
@@ -308,6 +319,7 @@ BakeResult bake(Editor& editor, const BakeOptions& options) {
           },
           editor.options());
       report.milliseconds["editor"] = ms_since(built);
+      bake_detail::prepare_like(editor, baked, report);
       report.cpu_milliseconds["total"] = bake_detail::cpu_ms() - cpu0;
       report.local = true;
       report.milliseconds["total"] = ms_since(t0);
@@ -322,11 +334,7 @@ BakeResult bake(Editor& editor, const BakeOptions& options) {
   full.fallback = reason;
   full.changed_vertices = report.changed_vertices;
   Editor baked(editor.result(), editor.options());
-  if (!editor.parts().base_order.empty()) { // ordered afresh, as the old base was
-    const auto t1 = Clock::now();
-    baked.order_base();
-    full.milliseconds["order"] = ms_since(t1);
-  }
+  bake_detail::prepare_like(editor, baked, full);
   full.milliseconds["total"] = ms_since(t0);
   return {std::move(baked), std::move(full)};
 }

@@ -200,12 +200,14 @@ const std::vector<int>& Editor::movable_vertices() const {
   return impl_->region ? impl_->region->encoded : none;
 }
 
-void Editor::order_base() {
+void Editor::prepare_regions() {
   Impl& m = *impl_;
+  if (m.base.n_vertices() > kMaxPreparedBaseVertices) return;
+  m.assembler->keep_rows(m.options.system);
   const int k = m.options.system.k;
   if ((!m.base_order.empty() && m.base_order_k == k) ||
       m.solver_name(m.options.system.areas != AreaWeights::Mixed) != "cholmod" ||
-      m.options.solver.ordering != "amd" || m.base.n_vertices() > kMaxOrderedBaseVertices)
+      m.options.solver.ordering != "amd")
     return;
   std::vector<int> keys = nested_dissection_keys(ring_pattern(m.assembler->minus_w(), k));
   if (keys.empty()) return;

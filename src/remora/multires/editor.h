@@ -180,7 +180,7 @@ struct EditorParts {
   /// B's vertex normals (vertex_normals() of topology and base_rest) when the maker has them;
   /// empty: the editor computes them.
   Eigen::MatrixXd base_normals;
-  /// A nested-dissection order of B's k-ring graph, a key per vertex (Editor::order_base();
+  /// A nested-dissection order of B's k-ring graph, a key per vertex (Editor::prepare_regions();
   /// a bake carries it over); empty when there is none. base_order_k: its k.
   std::vector<int> base_order;
   int base_order_k = 0;
@@ -266,16 +266,19 @@ public:
   /// The vertices of O that can move under the current region (the support, handles included),
   /// in increasing order; empty before set_region().
   const std::vector<int>& movable_vertices() const;
-  /// Orders the base once for the factors of later regions: a nested dissection of its k-ring
-  /// graph for the current k (linalg/nested_dissection.h), which each region's `cholmod` factor
-  /// in two halves follows instead of ordering its own rows: fewer flops and no ordering per
-  /// region (docs/solvers.md). Worth its cost (METIS on the whole base) before many regions:
-  /// `remora serve` and `remora bench edit` call it after loading, and a bake carries the order
-  /// over to the new base. Does nothing without the GPL solvers, with another solver than
-  /// `cholmod` (amd), above kMaxOrderedBaseVertices base vertices, or when the base is ordered
-  /// for this k already. Throws NumericalError when METIS fails (out of memory).
-  void order_base();
-  static constexpr std::size_t kMaxOrderedBaseVertices = 200000;
+  /// Precomputes, once, what the regions to come share: the rows of the base's k-harmonic
+  /// operator for the current k and area weights (KHarmonicAssembler::keep_rows: a region's
+  /// system is then copied out of them), and for `cholmod` (amd) a nested dissection of the
+  /// base's k-ring graph (linalg/nested_dissection.h), which each region's factor in two halves
+  /// then follows instead of ordering its own rows: fewer flops and no ordering per region
+  /// (docs/solvers.md). Worth its cost (METIS on the whole base) before many regions: `remora
+  /// serve` and `remora bench edit` call it after loading, and a bake of a prepared editor
+  /// prepares the new one (carrying the order over where it can). The results are those of an
+  /// unprepared editor to round-off. Does nothing above kMaxPreparedBaseVertices base vertices,
+  /// and no more than needed when called again (another k or weighting: for those). Throws
+  /// NumericalError when METIS fails (out of memory).
+  void prepare_regions();
+  static constexpr std::size_t kMaxPreparedBaseVertices = 200000;
   /// Changes k and the area weights for the next set_region(). Throws InvalidArgument for a k
   /// other than 1, 2, 3, or weights the configured solver cannot take.
   void set_system(const KHarmonicOptions& system);
