@@ -202,11 +202,11 @@ const std::vector<int>& Editor::movable_vertices() const {
 
 void Editor::prepare_regions() {
   Impl& m = *impl_;
-  if (m.base.n_vertices() > kMaxPreparedBaseVertices) return;
+  const std::string solver = m.solver_name(m.options.system.areas != AreaWeights::Mixed);
+  if (m.base.n_vertices() > kMaxPreparedBaseVertices || solver == "multigrid") return;
   m.assembler->keep_rows(m.options.system);
   const int k = m.options.system.k;
-  if ((!m.base_order.empty() && m.base_order_k == k) ||
-      m.solver_name(m.options.system.areas != AreaWeights::Mixed) != "cholmod" ||
+  if ((!m.base_order.empty() && m.base_order_k == k) || solver != "cholmod" ||
       m.options.solver.ordering != "amd")
     return;
   std::vector<int> keys = nested_dissection_keys(ring_pattern(m.assembler->minus_w(), k));

@@ -1,9 +1,9 @@
 #include "remora/multires/frame.h"
 
+#include <algorithm>
 #include <cassert>
 #include <cmath>
 #include <cstddef>
-#include <numeric>
 
 #include <Eigen/Geometry>
 #include <fmt/format.h>
@@ -121,13 +121,17 @@ FrameDetails frame_details(const TriangleTopology& topology,
   if (outputs.size() != details.size() || (!added.empty() && added.size() != details.size()))
     throw InvalidArgument(fmt::format("frame_details: {} details, {} outputs, {} added offsets",
                                       details.size(), outputs.size(), added.size()));
-  std::vector<std::size_t> order(details.size());
-  std::iota(order.begin(), order.end(), std::size_t{0});
+  // The details by their faces' first corners, in their own order among equals: counted.
   const auto first_corner = [&](std::size_t i) {
-    return topology.faces[static_cast<std::size_t>(details[i].base.face.idx())][0];
+    return static_cast<std::size_t>(
+        topology.faces[static_cast<std::size_t>(details[i].base.face.idx())][0]);
   };
-  std::stable_sort(order.begin(), order.end(),
-                   [&](std::size_t a, std::size_t b) { return first_corner(a) < first_corner(b); });
+  std::size_t corners = 0;
+  for (std::size_t i = 0; i < details.size(); ++i) corners = std::max(corners, first_corner(i) + 1);
+  std::vector<std::size_t> start(corners + 1, 0), order(details.size());
+  for (std::size_t i = 0; i < details.size(); ++i) ++start[first_corner(i) + 1];
+  for (std::size_t v = 1; v < start.size(); ++v) start[v] += start[v - 1];
+  for (std::size_t i = 0; i < details.size(); ++i) order[start[first_corner(i)]++] = i;
   FrameDetails out;
   out.records.reserve(details.size());
   out.outputs.reserve(details.size());
