@@ -251,9 +251,10 @@ TEST(KHarmonic, TheAssemblerBuildsTheRowsOfTheDefinition) {
 }
 
 // keep_rows(): a region's system copied out of the kept rows is the one multiplied out, bit for
-// bit, for every k and weighting; the rows of another k or weighting are multiplied out as before.
+// bit, for every k and weighting (rows of several blocks: the multiplied-out rows come in blocks
+// of consecutive rows above 4,096); the rows of another k or weighting are multiplied out.
 TEST(KHarmonic, KeptRowsGiveTheSameSystemsBitForBit) {
-  const Mesh mesh = make_icosphere(4);
+  const Mesh mesh = make_icosphere(5);
   const KHarmonicAssembler plain(mesh);
   KHarmonicAssembler kept(mesh);
   EXPECT_EQ(kept.kept_row_bytes(), 0u);

@@ -356,7 +356,8 @@ TEST(SplitCholesky, TheSeparatorDecouplesTwoBalancedHalves) {
 #ifdef REMORA_WITH_GPL_SOLVERS
 // The base's order (nested_dissection.h) of a region: the rows of one mesh-wide order, as the
 // editor gives them (Editor::prepare_regions). Its tree separator cuts the region into halves that do
-// not couple, thinner than a breadth-first level, and its keys are a postorder of the tree.
+// not couple, and its keys are a postorder of the tree. A forest, shared keys and keys too large
+// to count give splits that do not couple either.
 TEST(SplitCholesky, TheTreeOfANestedDissectionGivesAThinSeparator) {
   const Mesh mesh = make_icosphere(5);
   const KHarmonicAssembler assembler(mesh);
@@ -378,6 +379,21 @@ TEST(SplitCholesky, TheTreeOfANestedDissectionGivesAThinSeparator) {
         ASSERT_LT(tree.keys[static_cast<std::size_t>(it.row())],
                   tree.keys[static_cast<std::size_t>(j)]);
       }
+  // Two systems side by side (a forest), keys shared by pairs of rows (a bake's carried order),
+  // and keys too large to count (sorted instead): splits that do not couple.
+  const KHarmonicSystem small = sphere_system(2, AreaWeights::Mean, 3);
+  const SparseMatrix both = block_diagonal(s.matrix, small.matrix);
+  std::vector<int> both_keys = region_keys(base, s);
+  for (Eigen::Index r = 0; r < small.matrix.rows(); ++r)
+    both_keys.push_back(static_cast<int>(base.size() + static_cast<std::size_t>(r)));
+  expect_a_balanced_split(both, tree_separator(both, both_keys));
+  std::vector<int> shared = region_keys(base, s), large = shared;
+  for (int& k : shared) k /= 2;
+  for (int& k : large) k = 100 * k + 7;
+  expect_a_balanced_split(s.matrix, tree_separator(s.matrix, shared));
+  const Separator sorted_cut = tree_separator(s.matrix, large);
+  EXPECT_EQ(sorted_cut.part, tree.part); // the same order, counted or sorted
+  EXPECT_EQ(sorted_cut.keys, tree.keys);
   // A chain (a path graph in its own order) has no two subtrees to balance.
   SparseMatrix path(50, 50);
   for (int v = 0; v < 50; ++v) path.insert(v, v) = 4.0;
@@ -409,7 +425,8 @@ TEST(SplitCholesky, HalvesInTheBasesOrderSolveAsOneFactorDoes) {
     EXPECT_THROW(split.analyze(s.matrix, 5000, true, keys), InvalidArgument);
   }
   EXPECT_THROW(nested_dissection_keys(SparseMatrix(3, 4)), InvalidArgument);
-  // Through the solver's interface, on two threads (24.6k rows): the same solution.
+  // Through the solver's interface, on two threads (a system over the split's row threshold):
+  // the same solution, cut by the tree.
   const Mesh fine = make_icosphere(6);
   const std::vector<int> base =
       nested_dissection_keys(ring_pattern(KHarmonicAssembler(fine).minus_w(), 2));
@@ -422,6 +439,7 @@ TEST(SplitCholesky, HalvesInTheBasesOrderSolveAsOneFactorDoes) {
   solver->set_order_keys(keys);
   solver->compute(s.matrix);
   EXPECT_TRUE(solver->stats().keyed_order);
+  EXPECT_TRUE(solver->stats().tree_cut);
   EXPECT_GT(solver->stats().separator_rows, 0);
   EXPECT_LE(relative_difference(solver->solve(b), reference->solve(b)), 1e-9);
   keys.pop_back();

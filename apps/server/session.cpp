@@ -288,7 +288,7 @@ struct Session::Impl {
     std::optional<Editor::Prepared> prepared;
     try {
       editor.set_system({key.k, previous_system.areas});
-      editor.prepare_regions(); // for a new k (the load job prepared the first)
+      if (!token.stop_requested()) editor.prepare_regions(); // a new k (the load job: the first)
       editor.set_method(key.method);
       editor.set_nonlinear_energy(key.energy);
       if (work.new_region) prepared = editor.prepare_region(key.support, key.handles, token);

@@ -232,11 +232,11 @@ class Editor:
         """Precomputes, once, what the regions to come share: the rows of the base's operator
         for the current k (each :meth:`set_region` then copies its system out of them) and, with
         the "cholmod" solver, a nested dissection of the base (METIS), which each large region's
-        factor follows instead of ordering its own rows (docs/solvers.md). Worth its cost (about
-        a quarter of a second on the bunny) before many regions; does nothing on a base of more
-        than 200,000 vertices. The results are those of an unprepared editor to round-off;
-        ``report()["solver"]["keyed_order"]`` says whether a region's factor followed the
-        order."""
+        factor follows instead of ordering its own rows (docs/solvers.md). Worth its cost (METIS on
+        the whole base) before many regions; does nothing on a base of more than 200,000
+        vertices. The results are those of an unprepared editor to round-off;
+        ``report()["solver"]["keyed_order"]`` and ``["tree_cut"]`` say whether a region's factor
+        followed the order and was cut at its top."""
         self._editor.prepare_regions()
 
     def report(self) -> dict:

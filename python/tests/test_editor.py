@@ -150,21 +150,24 @@ def test_higher_k_bends_wider(bunny, bunny_editor):
 
 
 def test_a_prepared_editor_solves_as_an_unprepared_one(bunny):
-    # A region of about 19,000 free base vertices: factored in two halves, which follow the
-    # base's order once it exists. The result is the same to round-off.
+    # A region large enough to be factored in two halves on two threads, which are cut at the
+    # top of the base's order once it exists. The result is the same to round-off.
     support = np.flatnonzero(bunny.V[:, 1] > 0.075)
     handle = np.flatnonzero(bunny.V[:, 1] > 0.16)
     T = remora.transform(translate=(0.01, 0.02, 0))
-    moved = []
-    for ordered in (False, True):
-        editor = remora.Editor(bunny.V, bunny.F)
-        if ordered:
+    moved, separators = [], []
+    for prepared in (False, True):
+        editor = remora.Editor(bunny.V, bunny.F, threads=2)
+        if prepared:
             editor.prepare_regions()
         editor.set_region(support, [handle])
         editor.set_transform(0, T)
         moved.append(editor.positions())
         solver = editor.report()["solver"]
         if solver["name"] == "cholmod":
-            assert solver["keyed_order"] == ordered
+            assert solver["keyed_order"] == prepared and solver["tree_cut"] == prepared
             assert solver["separator_rows"] > 0
+            separators.append(solver["separator_rows"])
     assert np.abs(moved[0] - moved[1]).max() < 1e-9
+    if separators:
+        assert separators[1] < separators[0]  # the order's separator is the thinner cut

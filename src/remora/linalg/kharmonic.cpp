@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <future>
+#include <limits>
 #include <memory>
 #include <numeric>
 #include <string>
@@ -355,6 +356,14 @@ void KHarmonicAssembler::keep_rows(const KHarmonicOptions& options) {
   kept->k = options.k;
   kept->scaled = scaled;
   RowBlock& rows = kept->rows;
+  std::size_t entries = 0;
+  for (const RowBlock& b : blocks) entries += b.vertex.size();
+  if (entries > static_cast<std::size_t>(std::numeric_limits<int>::max()))
+    throw InvalidArgument("k-harmonic rows: " + std::to_string(entries) +
+                          " entries are more than 32-bit offsets hold; assemble each region");
+  rows.start.reserve(vertex_count() + 1);
+  rows.vertex.reserve(entries);
+  rows.value.reserve(entries);
   for (const RowBlock& b : blocks) {
     const int shift = rows.start.back();
     for (std::size_t i = 1; i < b.start.size(); ++i) rows.start.push_back(b.start[i] + shift);

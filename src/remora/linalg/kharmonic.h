@@ -110,8 +110,8 @@ public:
   /// Computes and keeps the rows of every vertex for `options`' k and area weighting (about 12
   /// bytes per entry: a 2-ring stencil per vertex for k = 2): later assemble() calls with the
   /// same k and weighting copy their free rows instead of multiplying them out, the same numbers
-  /// bit for bit. Another k or weighting is assembled as before, and keep_rows() for it replaces
-  /// the kept rows. For an editor that sets many regions on one base (Editor::prepare_regions).
+  /// bit for bit. Another k or weighting is multiplied out, and keep_rows() for it replaces the
+  /// kept rows. For an editor that sets many regions on one base (Editor::prepare_regions).
   /// Throws InvalidArgument for a k other than 1, 2, 3.
   void keep_rows(const KHarmonicOptions& options);
   /// The memory of the kept rows (0 without).

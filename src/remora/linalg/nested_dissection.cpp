@@ -23,14 +23,15 @@ std::vector<int> nested_dissection_keys(const Eigen::SparseMatrix<double>& a) {
   lower.makeCompressed();
   cholmod_sparse view = lower_view(n, static_cast<std::size_t>(lower.nonZeros()),
                                    lower.outerIndexPtr(), lower.innerIndexPtr(), nullptr);
+  std::vector<int> perm(n), keys(n);
   cholmod_common c;
   cholmod_start(&c);
   c.print = 0;
-  std::vector<int> perm(n);
   const int ok = cholmod_metis(&view, nullptr, 0, 1, perm.data(), &c);
+  const int status = c.status;
   cholmod_finish(&c);
+  if (status == CHOLMOD_NOT_INSTALLED) return {}; // a CHOLMOD built without METIS
   if (!ok) throw NumericalError("nested dissection: METIS failed (out of memory?)");
-  std::vector<int> keys(n);
   for (std::size_t k = 0; k < n; ++k) keys[static_cast<std::size_t>(perm[k])] = static_cast<int>(k);
   return keys;
 #else

@@ -15,8 +15,9 @@ namespace remora {
 
 /// The position of each row in a nested-dissection order of the symmetric pattern of `a`
 /// (n × n; lower triangle read; CHOLMOD's METIS, then its elimination tree's postorder): rows
-/// sorted by it eliminate the separators last. Empty without the GPL solvers (CHOLMOD). Throws
-/// InvalidArgument for a non-square matrix, NumericalError when METIS fails (out of memory).
+/// sorted by it eliminate the separators last. Empty without the GPL solvers, or with a CHOLMOD
+/// built without METIS. Throws InvalidArgument for a non-square matrix, NumericalError when METIS
+/// fails (out of memory).
 std::vector<int> nested_dissection_keys(const Eigen::SparseMatrix<double>& a);
 
 /// The k-ring graph of a mesh as a sparse pattern: the pattern of (−W)^k for the cotan matrix

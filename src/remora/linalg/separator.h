@@ -28,7 +28,8 @@ Separator level_separator(const Eigen::SparseMatrix<double>& a);
 /// Every subtree hanging from the path couples only to the path, so the subtrees (and the other
 /// trees) are shared between the halves, the largest first into the smaller one. With a nested-
 /// dissection order this is its top separator within `a`. Empty `part` when the halves end
-/// outside [0.4, 0.6] of the rest or the tree is one chain.
+/// outside [0.4, 0.6] of the rest or the tree is one chain, and for fewer than 3 rows, a
+/// non-square `a` or keys that are not one per row.
 Separator tree_separator(const Eigen::SparseMatrix<double>& a, const std::vector<int>& keys);
 
 } // namespace remora

@@ -156,6 +156,7 @@ public:
       stats_.factor_bytes = split_->factor_bytes();
       stats_.separator_rows = split_->separator_rows();
       stats_.keyed_order = !keys_.empty();
+      stats_.tree_cut = split_->cut_by_tree();
       factored_ = true;
       return;
     }
@@ -176,6 +177,7 @@ public:
       throw NumericalError(not_spd("cholmod"));
     stats_.factor_nonzeros = l->xsize;
     stats_.separator_rows = 0;
+    stats_.keyed_order = stats_.tree_cut = false;
     stats_.factor_bytes = l->xsize * sizeof(double) + l->ssize * sizeof(SuiteSparse_long) +
                           static_cast<std::size_t>(l->n) * 4 * sizeof(SuiteSparse_long);
     factored_ = true;

@@ -55,6 +55,7 @@ struct SolverStats {
   int bandwidth = 0;        ///< banded: half-bandwidth after the ordering
   int separator_rows = 0;   ///< cholmod: the separator's rows when factored in two halves, else 0
   bool keyed_order = false; ///< cholmod: the halves followed set_order_keys()
+  bool tree_cut = false;    ///< cholmod: the separator is the top of that order's tree
 };
 
 class Solver {
@@ -79,9 +80,10 @@ public:
   /// A fill-reducing order for the next analyze(): a key per row, the rows taken by increasing
   /// key (ties by row), e.g. a nested dissection of a larger graph restricted to the system's
   /// rows (nested_dissection.h). Empty: the solver orders the rows itself. Only `cholmod`'s two
-  /// halves follow it (each half's rows, then the separator's, by key, instead of CAMD); the
-  /// other solvers and `cholmod`'s one factor order as before. analyze() throws InvalidArgument
-  /// when the keys are not one per row.
+  /// halves use it: they are cut at the top of the order's elimination tree and each follows the
+  /// tree's postorder (separator.h), or, when that cut does not balance, cut at a breadth-first
+  /// level and each ordered by the keys; the other solvers and `cholmod`'s one factor ignore the
+  /// keys. analyze() throws InvalidArgument when the keys are not one per row.
   virtual void set_order_keys(std::vector<int> keys) { (void)keys; }
 
 protected:

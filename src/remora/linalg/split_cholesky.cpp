@@ -233,6 +233,7 @@ struct SplitCholesky::Impl {
   Eigen::MatrixXd schur;     // the Schur complement's Cholesky factor (lower triangle)
   std::uint64_t pattern = 0; // pattern_hash() of the analysed matrix
   bool factored = false;
+  bool by_tree = false; // the separator is tree_separator's
 
   // The bordered matrix of half i: its pattern and where each value comes from.
   void build_half(const Sparse& a, const std::vector<int>& local, int i) {
@@ -281,7 +282,8 @@ bool SplitCholesky::analyze(const Sparse& a, int max_separator_rows, bool coarse
     throw InvalidArgument("cholmod: " + std::to_string(keys.size()) + " order keys for " +
                           std::to_string(a.rows()) + " rows; give one per row or none");
   Separator split = keys.empty() ? Separator{} : tree_separator(a, keys);
-  if (split.part.empty() || split.separator_rows > max_separator_rows) {
+  m.by_tree = !split.part.empty() && split.separator_rows <= max_separator_rows;
+  if (!m.by_tree) {
     split = level_separator(a);
     split.keys = keys;
   }
@@ -410,6 +412,10 @@ std::size_t SplitCholesky::factor_bytes() const {
       bytes += h.factor->xsize * sizeof(double) + h.factor->ssize * sizeof(int) +
                h.factor->n * 4 * sizeof(int);
   return bytes;
+}
+
+bool SplitCholesky::cut_by_tree() const {
+  return impl_->by_tree;
 }
 
 int SplitCholesky::separator_rows() const {

@@ -37,11 +37,14 @@ public:
 
   /// Splits the symmetric pattern of `a` (compressed; lower triangle read) and analyses both
   /// halves, with coarser supernodes than CHOLMOD's defaults when `coarse_supernodes`
-  /// (solver.cpp). Each half's rows, then the separator's, are ordered by CAMD, or by increasing
-  /// `keys` (one per row of `a`; ties by row) when given (Solver::set_order_keys). Returns false,
-  /// keeping nothing, when `a` is not compressed or no separator of at most `max_separator_rows`
-  /// rows balances the graph; the caller then factors `a` as one. Throws InvalidArgument when
-  /// `keys` is neither empty nor one per row.
+  /// (solver.cpp). Without `keys`, the separator is a breadth-first level and each half's rows,
+  /// then the separator's, are ordered by CAMD. With `keys` (one per row of `a`; ties by row;
+  /// Solver::set_order_keys) the separator is the top of their elimination tree and the halves
+  /// follow its postorder (tree_separator), or, when that cut does not balance or is longer than
+  /// `max_separator_rows`, a breadth-first level with the halves in the keys' order. Returns
+  /// false, keeping nothing, when `a` is not compressed or no separator of at most
+  /// `max_separator_rows` rows balances the graph; the caller then factors `a` as one. Throws
+  /// InvalidArgument when `keys` is neither empty nor one per row.
   bool analyze(const Eigen::SparseMatrix<double>& a, int max_separator_rows, bool coarse_supernodes,
                const std::vector<int>& keys = {});
   /// The numbers of `a`, which has the pattern given to analyze(). Returns false when `a` is not
@@ -55,6 +58,9 @@ public:
   std::size_t factor_nonzeros() const;
   std::size_t factor_bytes() const;
   int separator_rows() const;
+  /// Whether the separator is the top of the keys' elimination tree (tree_separator), not a
+  /// breadth-first level.
+  bool cut_by_tree() const;
 
 private:
   struct Impl;

@@ -125,10 +125,12 @@ void update_assembler(const Bake& b, const SpliceMap* map, EditorParts& parts) {
   parts.assembler.emplace(parts.base, b.old.assembler, previous_of, changed, b.options.threads);
 }
 
-// The old base's nested-dissection order (Editor::prepare_regions) carried over: a vertex of the old
-// base keeps its key (the order depends on the graph only, and moving a vertex keeps its edges),
-// a patch vertex takes the key of the nearest one that has a key (breadth first). The order then
-// differs from a new one only inside the patch.
+// The old base's nested-dissection order (Editor::prepare_regions) carried over: a vertex of the
+// old base keeps its key (the order depends on the graph only, and moving a vertex keeps its
+// edges), a patch vertex takes the key of the nearest one that has a key (breadth first). Where
+// the patch crosses a separator of the order, the separator no longer separates there: a region
+// across the patch then gets a long tree path, and its factor is cut at a breadth-first level
+// with the halves in the carried order (docs/solvers.md).
 void carry_order(const Bake& b, const SpliceMap* map, EditorParts& parts) {
   if (b.old.base_order.empty()) return;
   const std::size_t n = parts.base.n_vertices();
@@ -287,7 +289,7 @@ void local_parts(const Editor& editor, const Eigen::MatrixXd& positions,
 
 // The new editor prepared for regions (Editor::prepare_regions) when the old one was: its rows
 // computed, its order carried over (carry_order) or, after a full re-preprocess, computed.
-void prepare_like(Editor& old, Editor& baked, BakeReport& report) {
+void prepare_like(const Editor& old, Editor& baked, BakeReport& report) {
   const EditorPartsView p = old.parts();
   if (p.assembler.kept_row_bytes() == 0 && p.base_order.empty()) return;
   const auto t0 = Clock::now();

@@ -176,6 +176,10 @@ Editor::Editor(const std::function<void(EditorParts&)>& build, EditorOptions opt
     m.statistics = base_statistics(m.base);
   if (!m.assembler || m.assembler->vertex_count() != m.base.n_vertices())
     m.assembler.emplace(m.base, m.options.threads);
+  if (m.base_order.size() != m.base.n_vertices()) { // none, or not this base's
+    m.base_order.clear();
+    m.base_order_k = 0;
+  }
   m.index_base_nearest();
 }
 
@@ -205,11 +209,18 @@ void Editor::prepare_regions() {
   const std::string solver = m.solver_name(m.options.system.areas != AreaWeights::Mixed);
   if (m.base.n_vertices() > kMaxPreparedBaseVertices || solver == "multigrid") return;
   m.assembler->keep_rows(m.options.system);
+  // The order serves the two-half factor alone, which needs two threads.
+  const int threads = m.options.threads > 0 ? m.options.threads : omp_get_max_threads();
   const int k = m.options.system.k;
   if ((!m.base_order.empty() && m.base_order_k == k) || solver != "cholmod" ||
-      m.options.solver.ordering != "amd")
+      m.options.solver.ordering != "amd" || threads < 2)
     return;
-  std::vector<int> keys = nested_dissection_keys(ring_pattern(m.assembler->minus_w(), k));
+  std::vector<int> keys;
+  try {
+    keys = nested_dissection_keys(ring_pattern(m.assembler->minus_w(), k));
+  } catch (const NumericalError&) {
+    return; // METIS failed: the regions order themselves, as without preparing
+  }
   if (keys.empty()) return;
   m.base_order = std::move(keys);
   m.base_order_k = k;
@@ -409,7 +420,8 @@ nlohmann::json to_json(const EditReport& r) {
                  {"residual", r.solver_stats.residual},
                  {"factor_bytes", r.solver_stats.factor_bytes},
                  {"separator_rows", r.solver_stats.separator_rows},
-                 {"keyed_order", r.solver_stats.keyed_order}};
+                 {"keyed_order", r.solver_stats.keyed_order},
+                 {"tree_cut", r.solver_stats.tree_cut}};
   j["phong"] = {{"encoded", r.phong.encoded},
                 {"walk_steps", r.phong.walk_steps},
                 {"extrapolated", r.phong.extrapolated},

@@ -268,15 +268,17 @@ public:
   const std::vector<int>& movable_vertices() const;
   /// Precomputes, once, what the regions to come share: the rows of the base's k-harmonic
   /// operator for the current k and area weights (KHarmonicAssembler::keep_rows: a region's
-  /// system is then copied out of them), and for `cholmod` (amd) a nested dissection of the
-  /// base's k-ring graph (linalg/nested_dissection.h), which each region's factor in two halves
-  /// then follows instead of ordering its own rows: fewer flops and no ordering per region
-  /// (docs/solvers.md). Worth its cost (METIS on the whole base) before many regions: `remora
-  /// serve` and `remora bench edit` call it after loading, and a bake of a prepared editor
-  /// prepares the new one (carrying the order over where it can). The results are those of an
-  /// unprepared editor to round-off. Does nothing above kMaxPreparedBaseVertices base vertices,
-  /// and no more than needed when called again (another k or weighting: for those). Throws
-  /// NumericalError when METIS fails (out of memory).
+  /// system is then copied out of them), and for `cholmod` (amd) on two threads or more a nested
+  /// dissection of the base's k-ring graph (linalg/nested_dissection.h), at the top of whose
+  /// elimination tree each region's two-half factor is then cut, each half following it, instead
+  /// of a breadth-first cut and CAMD: fewer flops and no ordering per region (docs/solvers.md).
+  /// Worth its cost (METIS on the whole base) before many regions: `remora serve` and `remora
+  /// bench edit` call it after loading, and a bake of a prepared editor prepares the new one
+  /// (carrying the order over where it can). The results are those of an unprepared editor to
+  /// round-off. Does nothing above kMaxPreparedBaseVertices base vertices or for the multigrid
+  /// solver; one set of rows and one order are kept, so another k or weighting prepares anew.
+  /// When METIS fails the regions order themselves (no order is kept); throws std::bad_alloc
+  /// when the rows do not fit.
   void prepare_regions();
   static constexpr std::size_t kMaxPreparedBaseVertices = 200000;
   /// Changes k and the area weights for the next set_region(). Throws InvalidArgument for a k
