@@ -1,12 +1,13 @@
 // A sparse Cholesky factorization on two threads: one level of nested dissection around CHOLMOD
 // (paper §5: the editor's k-harmonic systems, factored once per region).
 //
-// A separator S (one level of a breadth-first search of the matrix graph from a pseudo-peripheral
-// row) splits the rows into two halves that do not couple:
+// A separator S (separator.h: one level of a breadth-first search of the matrix graph, or the top
+// of a given order's elimination tree) splits the rows into two halves that do not couple:
 //
 //       [ A₁  0   C₁ ]
-//   K = [ 0   A₂  C₂ ]      each half bordered by S, M_i = [A_i C_i; C_iᵀ K_SS] = L_i L_iᵀ,
-//       [ C₁ᵀ C₂ᵀ K_SS]     is ordered by CAMD with S last and factored by CHOLMOD on its thread.
+//   K = [ 0   A₂  C₂ ]      each half bordered by S, M_i = [A_i C_i; C_iᵀ K_SS] = L_i L_iᵀ, is
+//       [ C₁ᵀ C₂ᵀ K_SS]     ordered with S last (by CAMD, or by the given order) and factored by
+//                           CHOLMOD on its thread.
 //
 // The trailing block of L_i is the factor of K_SS − C_iᵀA_i⁻¹C_i, so the Schur complement of S is
 // L₁L₁ᵀ + L₂L₂ᵀ − K_SS (symmetric positive definite whenever K is), factored densely. A solve is a
