@@ -268,9 +268,12 @@ TEST(FrameExport, ReplayedInSinglePrecisionGivesTheEditorsPositions) {
       worst = std::max(worst, (replayed.row(Eigen::Index(i)) - p.row(movable[i])).norm());
     EXPECT_LT(worst, 1e-5) << "detail mode " << int(mode); // the sphere's diagonal is 3.5
     EXPECT_GT(worst, 0.0);                                 // single precision is not double
-    // The nonlinear method's frames are not exported, but for blended motions (no iteration).
+    // The iterating energies' frames are exported as the linear one plus the server's offsets
+    // (the test below); blended motions as a blend of motions.
     editor.set_method(EditMethod::Nonlinear);
-    EXPECT_THROW(frame_export(editor), InvalidArgument);
+    const FrameExport corrected = frame_export(editor);
+    EXPECT_TRUE(corrected.corrected && !corrected.blended);
+    EXPECT_EQ(corrected.basis, f.basis);
     editor.set_nonlinear_energy(NonlinearEnergy::BlendedMotions);
     const FrameExport blended = frame_export(editor);
     EXPECT_TRUE(blended.blended);
@@ -293,7 +296,8 @@ TEST(FrameExport, ReplayedInSinglePrecisionGivesTheEditorsPositions) {
 // page's threads split it.
 std::vector<float> replay_with_library(const FrameExport& f,
                                        const std::vector<Transform>& transforms,
-                                       std::size_t movable, std::uint32_t parts = 1) {
+                                       std::size_t movable, std::uint32_t parts = 1,
+                                       const std::vector<float>* row_offsets = nullptr) {
   FrameReplay r;
   r.handles = std::uint32_t(f.handles);
   r.rows = std::uint32_t(f.free_local.size());
@@ -317,6 +321,7 @@ std::vector<float> replay_with_library(const FrameExport& f,
   r.record_residual = f.record_residual.data();
   r.residuals = f.residuals.data();
   r.offsets = f.offsets.empty() ? nullptr : f.offsets.data();
+  r.row_offsets = row_offsets ? row_offsets->data() : nullptr;
   std::vector<double> x(f.rest.begin(), f.rest.end()), cross(3 * std::size_t(r.ring_faces));
   r.x = x.data();
   r.cross = cross.data();
@@ -389,6 +394,63 @@ TEST(FrameReplay, TheLibrarysReplayGivesTheEditorsPositionsAndTheTestsReplay) {
       apart = std::max(apart, std::abs(double(rest[i]) - double(library[i])));
     EXPECT_GT(apart, 0.1);
   });
+}
+
+// The largest coordinate difference between a replay and the editor's positions.
+double replay_error(const std::vector<float>& replay, const Eigen::MatrixXd& p,
+                    const std::vector<int>& movable) {
+  double worst = 0.0;
+  for (std::size_t i = 0; i < movable.size(); ++i)
+    for (int c = 0; c < 3; ++c)
+      worst = std::max(worst, std::abs(double(replay[3 * i + std::size_t(c)]) - p(movable[i], c)));
+  return worst;
+}
+
+// Method nonlinear (rotated-laplacian): the linear replay plus the row offsets of the server's
+// last frame is that frame, to single precision; under a handle turned 2° further it is the
+// converged frame there to first order (far closer than the linear frame); linear's offsets
+// vanish to round-off; stale offsets and blended motions are refused.
+TEST(FrameExport, TheServersRowOffsetsMakeTheLinearReplayTheNonlinearFrame) {
+  for_each_export_case(
+      [](Editor& editor, const std::vector<Transform>& transforms, DetailMode mode) {
+        const std::vector<int>& movable = editor.movable_vertices();
+        editor.positions();
+        double linear_offset = 0.0;
+        for (const float d : frame_base_offsets(editor))
+          linear_offset = std::max(linear_offset, double(std::abs(d)));
+        EXPECT_LT(linear_offset, 1e-6) << "detail mode " << int(mode);
+        editor.set_method(EditMethod::Nonlinear);
+        const Eigen::MatrixXd p = editor.positions();
+        ASSERT_TRUE(editor.converged());
+        const FrameExport f = frame_export(editor);
+        const std::vector<float> d = frame_base_offsets(editor);
+        ASSERT_EQ(d.size(), 3 * f.free_local.size());
+        const double corrected =
+            replay_error(replay_with_library(f, transforms, movable.size(), 1, &d), p, movable);
+        const double linear =
+            replay_error(replay_with_library(f, transforms, movable.size()), p, movable);
+        EXPECT_LT(corrected, 1e-6) << "detail mode " << int(mode); // the sphere's diagonal is 3.5
+        EXPECT_GT(linear, 1e-2) << "detail mode " << int(mode);
+        // Split over two threads as the page does: the same bits.
+        EXPECT_EQ(replay_with_library(f, transforms, movable.size(), 2, &d),
+                  replay_with_library(f, transforms, movable.size(), 1, &d));
+
+        std::vector<Transform> turned = transforms;
+        turned[0] = compose(rotation({0, 1, 0}, 2.0 * M_PI / 180.0, {0, 0, 1}), transforms[0]);
+        editor.set_transform(0, turned[0]);
+        EXPECT_THROW(frame_base_offsets(editor), InvalidArgument); // a transform after the frame
+        const Eigen::MatrixXd q = editor.positions();
+        const double predicted =
+            replay_error(replay_with_library(f, turned, movable.size(), 1, &d), q, movable);
+        const double linear_there =
+            replay_error(replay_with_library(f, turned, movable.size()), q, movable);
+        EXPECT_LT(predicted, 0.1 * linear_there)
+            << "detail mode " << int(mode) << ": " << predicted << " against " << linear_there;
+
+        editor.set_nonlinear_energy(NonlinearEnergy::BlendedMotions);
+        editor.positions();
+        EXPECT_THROW(frame_base_offsets(editor), InvalidArgument);
+      });
 }
 
 } // namespace

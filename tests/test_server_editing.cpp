@@ -194,9 +194,11 @@ TEST(ServerEditing, UndoAndRedoThroughLocalBakesAreExact) {
 }
 
 // The region's kernel (GET /api/region/kernel): sections that add up to the body as its header
-// says; served for method linear and the energy blended-motions only. A move answered with
-// "none" is a 204 without positions that moves the server's shape all the same, when it is read.
-TEST(ServerEditing, TheKernelIsServedForFramesThatDoNotIterateAndAMoveCanGoUnanswered) {
+// says, `corrected` for the nonlinear energies that iterate. A move answered with "none" is a 204
+// without positions that moves the server's shape all the same, when it is read. Base offsets
+// follow the positions in an answer, one row per basis row of the kernel; blended motions have
+// none.
+TEST(ServerEditing, TheKernelIsServedAMoveCanGoUnansweredAndNonlinearAnswersBaseOffsets) {
   Session s;
   ASSERT_EQ(call(s, "POST", "/api/load", sphere_off(), {{"name", "sphere.off"}}).status, 202);
   s.wait();
@@ -246,13 +248,42 @@ TEST(ServerEditing, TheKernelIsServedForFramesThatDoNotIterateAndAMoveCanGoUnans
   expect_error(call(s, "POST", "/api/transform",
                     nlohmann::json{{"handle", 0}, {"matrix", lift}, {"answer", "all"}}.dump()),
                400, "answer");
-  // Method nonlinear: its frames stay on the server.
+  // Method nonlinear (rotated-laplacian): the same kernel, corrected by the base offsets that
+  // its frames answer after the positions.
   const nlohmann::json region = {
       {"support", r.support}, {"handles", {r.handle}}, {"method", "nonlinear"}};
   ASSERT_EQ(call(s, "POST", "/api/region", region.dump()).status, 202);
   s.wait();
-  expect_error(call(s, "GET", "/api/region/kernel"), 409, "nonlinear");
-  // But for the energy blended-motions, which does not iterate.
+  const HttpResponse corrected = call(s, "GET", "/api/region/kernel");
+  ASSERT_EQ(corrected.status, 200) << corrected.body;
+  EXPECT_EQ(as<std::uint32_t>(corrected)[13], 1u);
+  EXPECT_EQ(words[13], 0u);
+  const auto answer = [&](const char* path, nlohmann::json body, const char* what) {
+    body["answer"] = what;
+    return call(s, "POST", path, body.dump());
+  };
+  const HttpResponse moved =
+      answer("/api/transform", {{"handle", 0}, {"matrix", lift}}, "base-offsets");
+  ASSERT_EQ(moved.status, 200) << moved.body;
+  EXPECT_EQ(moved.headers.at("X-Base-Offset-Rows"), std::to_string(rows));
+  EXPECT_EQ(as<float>(moved).size(), 3 * std::size_t(rows));
+  const HttpResponse both =
+      answer("/api/relax", {{"budget_ms", 10000}}, "positions-and-base-offsets");
+  ASSERT_EQ(both.status, 200) << both.body;
+  EXPECT_EQ(both.headers.at("X-Converged"), "1");
+  const std::vector<float> both_floats = as<float>(both);
+  ASSERT_EQ(both_floats.size(), 3 * (r.support.size() + rows));
+  const std::vector<float> positions = as<float>(call(s, "GET", "/api/mesh/positions"));
+  for (std::size_t i = 0; i < r.support.size(); ++i)
+    for (std::size_t c = 0; c < 3; ++c)
+      EXPECT_EQ(positions[3 * std::size_t(r.support[i]) + c], both_floats[3 * i + c]);
+  const std::vector<float> base_offsets = as<float>(answer("/api/relax", {}, "base-offsets"));
+  EXPECT_TRUE(std::equal(base_offsets.begin(), base_offsets.end(), both_floats.end() - 3 * rows));
+  float largest = 0.0f;
+  for (const float d : base_offsets) largest = std::max(largest, std::abs(d));
+  EXPECT_GT(largest, 1e-4f); // nonlinear is not linear
+  expect_error(answer("/api/relax", {}, "none"), 400, "answer");
+  // The energy blended-motions (no iteration): its own kernel, and no base offsets.
   const nlohmann::json blended = {{"support", r.support},
                                   {"handles", {r.handle}},
                                   {"method", "nonlinear"},
@@ -262,7 +293,15 @@ TEST(ServerEditing, TheKernelIsServedForFramesThatDoNotIterateAndAMoveCanGoUnans
   const HttpResponse blended_kernel = call(s, "GET", "/api/region/kernel");
   ASSERT_EQ(blended_kernel.status, 200) << blended_kernel.body;
   EXPECT_EQ(as<std::uint32_t>(blended_kernel)[12], 1u);
+  EXPECT_EQ(as<std::uint32_t>(blended_kernel)[13], 0u);
   EXPECT_EQ(words[12], 0u);
+  const nlohmann::json before = status_of(s)["transforms"];
+  expect_error(
+      answer("/api/transform",
+             {{"handle", 0}, {"matrix", std::vector<double>{1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0.1}}},
+             "base-offsets"),
+      400, "blended-motions");
+  EXPECT_EQ(status_of(s)["transforms"], before); // refused before the move
 }
 
 TEST(ServerEditing, MirrorsCollapsesAndNumbersOutOfRangeAreRefused) {

@@ -9,7 +9,7 @@ import { ApiError, api, binary, bodyBytes, compactIds, json, message, post, task
 import * as view from './view.js';
 import { FIXED, FREE } from './view.js';
 import { Coalescer, faceNormal, pick } from './picking.js';
-import { evaluateKernel, parseKernel, releaseKernel } from './kernel.js';
+import { evaluateKernel, parseKernel, releaseKernel, setRowOffsets } from './kernel.js';
 import { engine, loadEngine } from './engine.js';
 import * as panels from './panels.js';
 
@@ -118,40 +118,54 @@ async function fetchRegion(s, labelsKnown) {
   loadKernel(s);
 }
 
-// ---- the frames of method linear and of blended motions in the page (kernel.js) ------------------
-// A drag under method linear or the energy blended-motions is evaluated here, from the region's
-// kernel fetched once after the region is ready; the server is sent every map (without an
-// answer) and answers the last one of the drag, whose positions the page then shows. Until the kernel is here, and for the nonlinear
-// energies that iterate, the server's answers are the frames.
-let kernel = null; // { regionId, data, out }
+// ---- the frames of a drag in the page (kernel.js) -----------------------------------------------
+// A drag is evaluated here, from the region's kernel fetched once after the region is ready.
+// Under method linear and the energy blended-motions the server is sent every map (without an
+// answer) and answers the last one of the drag, whose positions the page then shows. Under the
+// energies that iterate the kernel is corrected: every map is answered with the base offsets of
+// the server's nonlinear frame, which the page adds to its linear blend from then on, so each
+// display frame is the server's last nonlinear base plus the linear change since; the drag ends,
+// and the pauses relax, on the server's positions. Until the kernel (and a corrected kernel's
+// first offsets) is here, the server's answers are the frames.
+let kernel = null; // { regionId, method, data, out, synced }
 const engineLoaded = kernelInJs ? Promise.resolve('js') : loadEngine();
+/// The page's method choice of a region of the status.
+const methodOf = (region) => (region?.method === 'nonlinear' && region.energy === 'blended-motions' ? 'blended-motions' : region?.method);
 function loadKernel(s) {
   releaseKernel(kernel?.data);
   kernel = null;
-  const computable = s.region?.method === 'linear' || s.region?.energy === 'blended-motions';
-  if (!pageFrames || !computable || !state.movable) return;
-  const regionId = s.region_id, movable = state.movable;
+  if (!pageFrames || !s.region || !state.movable) return;
+  const regionId = s.region_id, movable = state.movable, method = methodOf(s.region);
   Promise.all([fetch('api/region/kernel').then((r) => (r.ok ? bodyBytes(r) : null)), engineLoaded]).then(([buffer]) => {
     if (!buffer || state.held.region !== regionId || state.movable !== movable) return;
     const data = parseKernel(buffer, view.drawnNormals(movable));
     releaseKernel(kernel?.data);
-    kernel = { regionId, data, out: new Float32Array(3 * movable.length) };
+    kernel = { regionId, method, data, out: new Float32Array(3 * movable.length), synced: !data.corrected };
     state.marks.kernel.push({ at: performance.now(), bytes: buffer.byteLength });
+    // A corrected kernel's first offsets: a relax step (nothing moves where it has converged).
+    if (data.corrected && !frames.pending) frames.submit({ relax: true, offsets: true });
   }).catch((e) => console.warn(`region kernel: ${e.message}; the server's frames are shown`));
 }
 function kernelUsable() {
-  return !!kernel && kernel.regionId === state.held.region && (state.method === 'linear' || state.method === 'blended-motions') &&
+  return !!kernel && kernel.synced && kernel.regionId === state.held.region && kernel.method === state.method &&
          !!state.movable && kernel.out.length === 3 * state.movable.length &&
          state.selected < kernel.data.handles;
 }
+/// Whether the server's answers should carry base offsets (a corrected kernel of this region).
+const kernelCorrected = () => !!kernel && kernel.data.corrected && kernel.regionId === state.held.region;
 const transformRows = () => state.transforms.map(matrixToRows);
+/// The page's frame under the live transforms, shown.
+function showKernelFrame() {
+  evaluateKernel(kernel.data, transformRows(), kernel.out);
+  const evaluated = performance.now();
+  view.applyMoved(state.movable, kernel.out, kernel.data.wasm?.drawn ?? null);
+  return evaluated;
+}
 /// A frame of the drag evaluated in the page; false when it cannot be (then the server's is shown).
 function localFrame(t0) {
   if (!kernelUsable()) return false;
-  evaluateKernel(kernel.data, transformRows(), kernel.out);
-  const evaluated = performance.now();
+  const evaluated = showKernelFrame();
   state.frameMs = evaluated - t0;
-  view.applyMoved(state.movable, kernel.out, kernel.data.wasm?.drawn ?? null);
   const done = performance.now();
   state.marks.drag.push(done - t0);
   state.marks.dragKernel.push(evaluated - t0);
@@ -401,24 +415,46 @@ function matrixToRows(m) {
 }
 
 // A frame: a handle's new map (POST transform), or for the nonlinear method more iterations under
-// the same maps while the pointer rests (POST relax). The answer is the movable vertices' positions.
+// the same maps while the pointer rests (POST relax). The answer is the movable vertices'
+// positions, none for a frame the page showed itself, and with a corrected kernel the base
+// offsets after them (request.offsets).
 const RELAX_PAUSE_MS = 120, RELAX_BUDGET_MS = 40;
+function frameAnswer(request) {
+  if (request.local) return request.offsets ? 'base-offsets' : 'none';
+  return request.offsets ? 'positions-and-base-offsets' : 'positions';
+}
 async function sendFrame(request) {
   request.sent = performance.now();
+  const answer = frameAnswer(request);
   // A refused relax (the server busy with a new region) is dropped without a message.
   const response = request.relax
     ? await fetch('api/relax', { method: 'POST', headers: { 'Content-Type': 'application/json' },
-                                 body: JSON.stringify({ budget_ms: RELAX_BUDGET_MS }) })
+                                 body: JSON.stringify({ budget_ms: RELAX_BUDGET_MS, answer }) })
     : await api('transform', { method: 'POST', headers: { 'Content-Type': 'application/json' },
-                               body: JSON.stringify({ handle: request.handle, matrix: request.matrix,
-                                                      answer: request.local ? 'none' : 'positions' }) });
+                               body: JSON.stringify({ handle: request.handle, matrix: request.matrix, answer }) });
   if (!response.ok) throw new ApiError(response.status, 'relax refused');
-  const buffer = await bodyBytes(response);
-  return { moved: new Float32Array(buffer), bytes: buffer.byteLength, ms: parseFloat(response.headers.get('X-Frame-Ms')),
-           converged: response.headers.get('X-Converged') !== '0' };
+  const buffer = await bodyBytes(response), floats = new Float32Array(buffer);
+  const rows = Number(response.headers.get('X-Base-Offset-Rows') ?? 0), split = floats.length - 3 * rows;
+  return { moved: floats.subarray(0, split), offsets: rows > 0 ? floats.subarray(split) : null, bytes: buffer.byteLength,
+           ms: parseFloat(response.headers.get('X-Frame-Ms')), converged: response.headers.get('X-Converged') !== '0' };
 }
 let lastMove = 0, relaxTimer = null;
+/// A corrected kernel takes the answer's base offsets; a frame the page showed is shown again
+/// under the live transforms with them.
+function receiveOffsets(result, request) {
+  if (!result.offsets || !kernelCorrected() || !setRowOffsets(kernel.data, result.offsets)) return;
+  kernel.synced = true;
+  if (!request.local || !kernelUsable()) return;
+  const received = performance.now();
+  showKernelFrame();
+  state.marks.dragBytes.push(result.bytes);
+  state.marks.dragServer.push(result.ms);
+  state.marks.dragTrip.push(received - request.sent);
+  state.converged = result.converged;
+  if (!result.converged) relaxSoon();
+}
 const frames = new Coalescer(sendFrame, (result, request) => {
+  receiveOffsets(result, request);
   if (request.local) return; // shown by localFrame(), which also timed it
   if (!state.movable || result.moved.length !== 3 * state.movable.length) return;
   state.frameMs = result.ms;
@@ -443,7 +479,7 @@ function relaxSoon() {
   const wait = Math.max(0, lastMove + RELAX_PAUSE_MS - performance.now());
   relaxTimer = setTimeout(() => {
     relaxTimer = null;
-    if (!frames.pending && performance.now() - lastMove >= RELAX_PAUSE_MS) frames.submit({ relax: true });
+    if (!frames.pending && performance.now() - lastMove >= RELAX_PAUSE_MS) frames.submit({ relax: true, offsets: kernelCorrected() });
     else if (!frames.pending) relaxSoon();
   }, wait);
 }
@@ -466,7 +502,7 @@ gizmo.addEventListener('dragging-changed', (event) => {
   const handle = state.selected, last = draggedLocally;
   task(async () => {
     // The page showed its own frames: the drag ends on the server's (the reference).
-    if (last) frames.submit({ handle, matrix: matrixToRows(state.transforms[handle]), t0: performance.now(), last: true });
+    if (last) frames.submit({ handle, matrix: matrixToRows(state.transforms[handle]), t0: performance.now(), last: true, offsets: kernelCorrected() });
     await frames.idle();
     try { await post('commit'); state.status = await json('status'); panels.showStats(state.status, state.frameMs); } catch (e) { /* shown */ }
     if (baseShown()) await showBase(false);
@@ -482,7 +518,7 @@ gizmo.addEventListener('objectChange', () => {
   lastMove = performance.now();
   const local = localFrame(lastMove);
   draggedLocally ||= local;
-  frames.submit({ handle: state.selected, matrix: matrixToRows(t), t0: lastMove, local });
+  frames.submit({ handle: state.selected, matrix: matrixToRows(t), t0: lastMove, local, offsets: kernelCorrected() });
 });
 
 // ---- the base surface ---------------------------------------------------------------------------

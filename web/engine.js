@@ -56,12 +56,13 @@ export function wasmLayout() {
 /// 0); `control`: 16 bytes reserved in the instance's memory for the handshake (Int32: the
 /// step's number, the step, the number of the step the worker finished); `stackTop`: the end of
 /// an area reserved for the worker's stack (each instance has its own stack pointer, and the
-/// page's stack is the module's own, below __heap_base).
+/// page's stack is the module's own, below __heap_base). `worker` false: the page's thread alone
+/// (a corrected kernel's frames, while the server iterates on the cores: web/kernel.js).
 export class FrameThreads {
-  constructor(instance, args, control, stackTop) {
+  constructor(instance, args, control, stackTop, worker = true) {
     Object.assign(this, { exports: instance.exports, args, ready: false, worker: null });
     this.control = new Int32Array(instance.buffer, control, 4);
-    if (typeof Worker === 'undefined' || (globalThis.navigator?.hardwareConcurrency ?? 1) < 2) return;
+    if (!worker || typeof Worker === 'undefined' || (globalThis.navigator?.hardwareConcurrency ?? 1) < 2) return;
     try {
       this.worker = new Worker(new URL('kernel_worker.js', import.meta.url), { type: 'module' });
     } catch (e) {

@@ -1,6 +1,7 @@
-// The frames of method linear and of the nonlinear energy blended-motions evaluated in the page,
-// so that a drag waits for no round trip: the blend of the basis functions (or of the handles'
-// motions), the base's normals where they can change and the Phong decode, the same steps and
+// The frames of a drag evaluated in the page, so that a drag waits for no round trip: the blend
+// of the basis functions (for the nonlinear energies that iterate, plus the base offsets of the
+// server's last frame; for blended-motions, of the handles' motions instead), the base's normals
+// where they can change and the Phong decode, the same steps and
 // formulas as the server's frame (src/remora/multires/frame.h, frame_export.h, motion_blend.h,
 // phong_decode.h) on the data of `GET /api/region/kernel` (single precision). The server stays
 // the reference: the page sends every map to it and shows its answer at the end of a drag;
@@ -26,7 +27,7 @@ const WORKER_STACK = 1 << 16; // the worker instance's stack, in the region's me
 export function parseKernel(buffer, drawn = null) {
   const header = new Uint32Array(buffer, 0, HEADER_WORDS);
   const [version, handles, local, rows, columns, handleVertices, faces, normalVertices, ringLength,
-    records, residuals, hasOffsets, blended] = header;
+    records, residuals, hasOffsets, blended, corrected] = header;
   if (version !== 1) throw new Error(`region kernel: version ${version}, expected 1`);
   let at = 4 * HEADER_WORDS;
   const take = (Type, n) => {
@@ -35,7 +36,7 @@ export function parseKernel(buffer, drawn = null) {
     return view;
   };
   const k = {
-    handles, local, rows, columns, records, blended: blended === 1,
+    handles, local, rows, columns, records, blended: blended === 1, corrected: corrected === 1,
     rest: take(Float32Array, 6 * local),
     freeLocal: take(Uint32Array, rows),
     basis: take(Float32Array, rows * columns),
@@ -52,6 +53,8 @@ export function parseKernel(buffer, drawn = null) {
     recordResidual: take(Int32Array, records),
     residuals: take(Float32Array, 3 * residuals),
     offsets: hasOffsets ? take(Float32Array, 3 * records) : null,
+    // Added to step 1's blend: the server's base offsets (setRowOffsets()), zero until they come.
+    rowOffsets: corrected === 1 ? new Float32Array(3 * rows) : null,
   };
   if (at !== buffer.byteLength || columns !== 3 + 4 * handles)
     throw new Error(`region kernel: ${buffer.byteLength} bytes, its header describes ${at}`);
@@ -92,7 +95,7 @@ function javascriptRows(k) {
 
 /// Copies the kernel's arrays into the memory of a new instance of kernel.wasm (web/engine.js; one
 /// per region: its memory goes with the kernel) and lays out struct FrameReplay (frame_replay.h:
-/// 24 words of 4 bytes) over them. k.xn becomes the instance's working rows, so that the
+/// 25 words of 4 bytes) over them. k.xn becomes the instance's working rows, so that the
 /// JavaScript steps (blended motions) write where the WebAssembly ones read. The drawn normals'
 /// positions begin with the frame's result (the moved vertices' slots are its slots).
 function attachWasm(k, layout, drawn) {
@@ -106,24 +109,38 @@ function attachWasm(k, layout, drawn) {
   const names = ['rest', 'freeLocal', 'basis', 'handleBegin', 'handleLocal', 'faces', 'normalVertices', 'ringBegin',
     'ring', 'recordFace', 'recordSlot', 'recordBary', 'recordOffset', 'recordResidual', 'residuals', 'offsets'];
   const pointers = names.map((name) => place(k[name]));
+  const rowOffsets = place(k.rowOffsets);
   const x = layout.reserve(8 * 6 * k.local), cross = layout.reserve(8 * 3 * k.ringFaces);
   if (drawn && drawn.movable.length !== k.slots) drawn = null; // not the movable vertices of these records
   const slots = drawn ? drawn.movable.length + drawn.constants.length : k.slots;
   const transforms = layout.reserve(8 * 12 * k.handles), out = layout.reserve(4 * 3 * slots);
   const placeDrawn = drawn ? placeDrawnNormals(layout, drawn, out) : null;
-  const struct = layout.reserve(4 * 24), control = layout.reserve(16), stack = layout.reserve(WORKER_STACK);
+  const struct = layout.reserve(4 * 25), control = layout.reserve(16), stack = layout.reserve(WORKER_STACK);
   const instance = layout.instantiate(), memory = instance.buffer;
   // The JavaScript steps read the same copies: the region's data is held once.
   for (const [offset, array] of sections) new array.constructor(memory, offset, array.length).set(array);
   names.forEach((name, i) => { if (k[name]) k[name] = new k[name].constructor(memory, pointers[i], k[name].length); });
-  new Uint32Array(memory, struct, 24).set([k.handles, k.rows, k.columns, k.normalVertices.length, k.records,
-    k.ringFaces, ...pointers, x, cross]);
+  if (k.rowOffsets) k.rowOffsets = new Float32Array(memory, rowOffsets, k.rowOffsets.length);
+  new Uint32Array(memory, struct, 25).set([k.handles, k.rows, k.columns, k.normalVertices.length, k.records,
+    k.ringFaces, ...pointers, x, cross, rowOffsets]);
   k.xn = new Float64Array(memory, x, 6 * k.local);
   k.xn.set(k.rest);
   const placed = placeDrawn ? placeDrawn(memory) : null;
-  const threads = new FrameThreads(instance, [struct, transforms, out, placed?.struct ?? 0], control, stack + WORKER_STACK);
+  // A corrected kernel's frames keep to the page's thread: the server iterates on both cores
+  // during its drags, and a worker waiting for the next step would take one of them.
+  const threads = new FrameThreads(instance, [struct, transforms, out, placed?.struct ?? 0], control, stack + WORKER_STACK,
+                                   !k.corrected);
   k.wasm = { threads, maps: new Float64Array(memory, transforms, 12 * k.handles), result: new Float32Array(memory, out, 3 * k.slots),
              drawn: placed && { movable: placed.movable, update: (positions, normals) => placed.update(positions, normals, () => threads.run(4)) } };
+}
+
+/// A corrected kernel's row offsets (Float32Array, x, y, z per basis row: the server's answer
+/// "base-offsets", docs/server.md), which the next frames add to their blend. False, and nothing
+/// changes, when the kernel is not corrected or the rows do not match.
+export function setRowOffsets(k, offsets) {
+  if (!k.rowOffsets || offsets.length !== k.rowOffsets.length) return false;
+  k.rowOffsets.set(offsets);
+  return true;
 }
 
 /// Ends what a kernel holds beyond its arrays (the worker of its frames).
@@ -302,9 +319,10 @@ function inverseTranspose(A) {
 
 /// Step 1: the basis rows times C = [I; M_0ᵀ; t_0ᵀ; ...] (the identity's three columns, then
 /// per handle w · the rows of [M_j | t_j], summed in the order of the columns, as
-/// frame_replay.cpp does), and the handles' own vertices moved rigidly with their maps.
+/// frame_replay.h does), plus the row offsets of a corrected kernel, and the handles' own
+/// vertices moved rigidly with their maps.
 function blend(k, transforms) {
-  const { columns, basis, freeLocal, rows, xn: x, handles } = k;
+  const { columns, basis, freeLocal, rows, xn: x, handles, rowOffsets } = k;
   const maps = [];
   for (let j = 0; j < handles; ++j) maps.push(transforms[j] ?? IDENTITY);
   for (let i = 0; i < rows; ++i) {
@@ -317,6 +335,7 @@ function blend(k, transforms) {
         px += wc * t[c]; py += wc * t[4 + c]; pz += wc * t[8 + c];
       }
     }
+    if (rowOffsets) { px += rowOffsets[3 * i]; py += rowOffsets[3 * i + 1]; pz += rowOffsets[3 * i + 2]; }
     const v = 6 * freeLocal[i];
     x[v] = px; x[v + 1] = py; x[v + 2] = pz;
   }

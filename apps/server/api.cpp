@@ -175,26 +175,41 @@ HttpResponse region(Session& session, const HttpRequest& request, const ApiLimit
   return json_response(202, session.status());
 }
 
-/// A frame's positions as Float32 with its figures in headers: X-Frame-Ms (the server's time),
-/// X-Converged (1, or 0 while method nonlinear still iterates), X-Iterations.
+/// A frame's answer as Float32: the positions, then the base's row offsets, each when asked
+/// for; its figures in headers: X-Frame-Ms (the server's time), X-Converged (1, or 0 while method
+/// nonlinear still iterates), X-Iterations, and with offsets X-Base-Offset-Rows (their rows, 3
+/// floats each, at the end of the body).
 HttpResponse frame_response(const Frame& f) {
   HttpResponse r = binary_response(f.positions);
+  if (!f.base_offsets.empty())
+    r.body.append(reinterpret_cast<const char*>(f.base_offsets.data()),
+                  f.base_offsets.size() * sizeof(float));
   r.headers["X-Frame-Ms"] = fmt::format("{:.3f}", f.ms);
-  r.headers["X-Converged"] = f.converged ? "1" : "0";
+  r.headers["X-Converged"] = std::to_string(f.converged ? 1 : 0);
   r.headers["X-Iterations"] = std::to_string(f.iterations);
+  if (!f.base_offsets.empty())
+    r.headers["X-Base-Offset-Rows"] = std::to_string(f.base_offsets.size() / 3);
   return r;
+}
+
+/// The "answer" of a transform or relax request (default "positions").
+FrameAnswer frame_answer(const json& j) {
+  if (!j.contains("answer")) return FrameAnswer::Positions;
+  const json& a = j.at("answer");
+  if (a.is_string()) {
+    if (a == "positions") return FrameAnswer::Positions;
+    if (a == "none") return FrameAnswer::None;
+    if (a == "base-offsets") return FrameAnswer::BaseOffsets;
+    if (a == "positions-and-base-offsets") return FrameAnswer::PositionsAndBaseOffsets;
+  }
+  throw BadRequest("answer: expected \"positions\" (the default), \"none\", \"base-offsets\" "
+                   "or \"positions-and-base-offsets\"");
 }
 
 HttpResponse transform(Session& session, const HttpRequest& request, const ApiLimits& limits) {
   const json j = parse_json(request, limits);
   only_keys(j, {"handle", "matrix", "answer"});
-  bool positions = true;
-  if (j.contains("answer")) {
-    const json& a = j.at("answer");
-    if (!a.is_string() || (a != "positions" && a != "none"))
-      throw BadRequest("answer: expected \"positions\" (the default) or \"none\"");
-    positions = a == "positions";
-  }
+  const FrameAnswer answer = frame_answer(j);
   if (!j.contains("handle") || !j.at("handle").is_number_integer())
     throw BadRequest("handle: expected a handle index");
   const json& m = j.contains("matrix") ? j.at("matrix") : json();
@@ -208,8 +223,8 @@ HttpResponse transform(Session& session, const HttpRequest& request, const ApiLi
         throw BadRequest(fmt::format("matrix[{}]: expected a finite number", 4 * r + c));
       t(r, c) = x.get<double>();
     }
-  HttpResponse r = frame_response(session.set_transform(j.at("handle").get<int>(), t, positions));
-  if (!positions) {
+  HttpResponse r = frame_response(session.set_transform(j.at("handle").get<int>(), t, answer));
+  if (answer == FrameAnswer::None) {
     r.status = 204;
     r.body.clear();
   }
@@ -219,7 +234,7 @@ HttpResponse transform(Session& session, const HttpRequest& request, const ApiLi
 /// The region's frame (FrameExport) in one buffer of 4-byte little-endian words: a header of 16
 /// Uint32 (version 1, handles, local vertices, basis rows, basis columns, handle vertices, faces,
 /// normal vertices, ring length, records, residuals, offsets 0 or 1, blended motions 0 or 1,
-/// 0...), then rest, free_local, basis, handle_begin, handle_local, faces, normal_vertices, ring_begin,
+/// corrected by the base offsets 0 or 1, 0...), then rest, free_local, basis, handle_begin, handle_local, faces, normal_vertices, ring_begin,
 /// ring, record_face, record_slot, record_bary, record_offset, record_residual, residuals,
 /// offsets (docs/server.md).
 HttpResponse kernel_response(const FrameExport& f) {
@@ -237,7 +252,8 @@ HttpResponse kernel_response(const FrameExport& f) {
                                     count(f.record_face),
                                     count(f.residuals) / 3,
                                     f.offsets.empty() ? 0u : 1u,
-                                    f.blended ? 1u : 0u};
+                                    f.blended ? 1u : 0u,
+                                    f.corrected ? 1u : 0u};
   HttpResponse r;
   r.content_type = "application/octet-stream";
   const auto append = [&r](const void* data, std::size_t bytes) {
@@ -264,21 +280,26 @@ HttpResponse kernel_response(const FrameExport& f) {
   return r;
 }
 
-/// POST /api/relax {"budget_ms": B}: method nonlinear goes on iterating under the live
-/// transforms for at most B milliseconds (default 50).
+/// POST /api/relax {"budget_ms": B, "answer": A}: method nonlinear goes on iterating under the
+/// live transforms for at most B milliseconds (default 50); A as for a transform, but "none".
 HttpResponse relax(Session& session, const HttpRequest& request, const ApiLimits& limits) {
   double budget = 50.0;
+  FrameAnswer answer = FrameAnswer::Positions;
   if (!request.body.empty()) {
     const json j = parse_json(request, limits);
-    only_keys(j, {"budget_ms"});
+    only_keys(j, {"budget_ms", "answer"});
     if (j.contains("budget_ms")) {
       const json& b = j.at("budget_ms");
       if (!b.is_number() || !(b.get<double>() > 0.0) || !(b.get<double>() <= 10000.0))
         throw BadRequest("budget_ms: expected milliseconds above 0, at most 10000");
       budget = b.get<double>();
     }
+    answer = frame_answer(j);
+    if (answer == FrameAnswer::None)
+      throw BadRequest("answer: a relax step answers \"positions\", \"base-offsets\" or "
+                       "\"positions-and-base-offsets\"");
   }
-  return frame_response(session.relax(budget));
+  return frame_response(session.relax(budget, answer));
 }
 
 /// A 3-vector of finite numbers at `key`.

@@ -137,6 +137,14 @@ struct Session::Impl {
     require_ready();
     if (!region) throw Busy("no region yet: paint a support and a handle first");
   }
+  /// Base offsets are refused before anything changes where frame_base_offsets() refuses them.
+  void require_offsets(FrameAnswer answer) const {
+    const EditorOptions& o = box->editor.options();
+    if ((answer == FrameAnswer::BaseOffsets || answer == FrameAnswer::PositionsAndBaseOffsets) &&
+        o.method == EditMethod::Nonlinear && o.nonlinear.energy == NonlinearEnergy::BlendedMotions)
+      throw InvalidArgument("the energy blended-motions has no base offsets: its frames blend "
+                            "the handles' motions (answer \"positions\" or \"none\")");
+  }
   void push_snapshot() {
     if (!history.empty()) history.resize(cursor + 1); // drop the redo branch
     history.push_back({box, region, transforms});
@@ -326,12 +334,15 @@ struct Session::Impl {
     push_snapshot();
   }
   /// positions(budget) of the editor, as the answer to a move or a relax step. Under the lock.
-  Frame frame(double budget_ms) {
+  Frame frame(double budget_ms, FrameAnswer answer = FrameAnswer::Positions) {
     Editor& editor = box->editor;
     const auto t0 = Clock::now();
     Frame f;
     const Eigen::MatrixXd& p = editor.positions(budget_ms);
-    f.positions = movable_floats(editor, p);
+    if (answer == FrameAnswer::Positions || answer == FrameAnswer::PositionsAndBaseOffsets)
+      f.positions = movable_floats(editor, p);
+    if (answer == FrameAnswer::BaseOffsets || answer == FrameAnswer::PositionsAndBaseOffsets)
+      f.base_offsets = frame_base_offsets(editor);
     f.converged = editor.converged();
     f.iterations = editor.report().method == "nonlinear" ? editor.report().nonlinear.iterations : 0;
     f.ms = last_frame_ms = ms_since(t0);
@@ -459,24 +470,27 @@ void Session::start_region(std::vector<int> support, std::vector<std::vector<int
   });
 }
 
-Frame Session::set_transform(int handle, const Transform& transform, bool answer) {
+Frame Session::set_transform(int handle, const Transform& transform, FrameAnswer answer) {
   std::lock_guard lock(impl_->mutex);
   Impl& m = *impl_;
   m.require_region();
+  m.require_offsets(answer);
   m.box->editor.set_transform(handle, transform); // validates
   m.transforms[static_cast<std::size_t>(handle)] = transform;
-  if (answer) return m.frame(m.options.frame_budget_ms);
+  if (answer != FrameAnswer::None) return m.frame(m.options.frame_budget_ms, answer);
   m.shape_behind = true;
   return {}; // no positions, no frame time
 }
 
-Frame Session::relax(double budget_ms) {
+Frame Session::relax(double budget_ms, FrameAnswer answer) {
   std::lock_guard lock(impl_->mutex);
   Impl& m = *impl_;
   m.require_region();
+  m.require_offsets(answer);
   if (!(budget_ms > 0.0) || !(budget_ms <= 10000.0))
     throw InvalidArgument("budget_ms: expected milliseconds above 0, at most 10000");
-  return m.frame(budget_ms);
+  if (answer == FrameAnswer::None) throw InvalidArgument("a relax step answers something");
+  return m.frame(budget_ms, answer);
 }
 
 void Session::commit() {
@@ -627,12 +641,6 @@ FrameExport Session::frame_export() const {
   std::lock_guard lock(impl_->mutex);
   const Impl& m = *impl_;
   m.require_region();
-  const EditorOptions& o = m.box->editor.options();
-  if (o.method != EditMethod::Linear && o.nonlinear.energy != NonlinearEnergy::BlendedMotions)
-    throw Busy(fmt::format("the region's method is nonlinear with the energy {}: its frames "
-                           "iterate here (the kernel is served for method linear and the energy "
-                           "blended-motions)",
-                           to_string(o.nonlinear.energy)));
   return remora::frame_export(m.box->editor);
 }
 

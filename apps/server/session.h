@@ -56,11 +56,19 @@ struct SessionOptions {
   EditorOptions editor;
 };
 
+/// What a handle move or a relax step answers: nothing (a client that evaluates its own frames),
+/// the positions of movable_vertices(), the base's row offsets (multires/frame_export.h,
+/// frame_base_offsets(): a client that evaluates a nonlinear region's frames from its kernel),
+/// or both.
+enum class FrameAnswer { None, Positions, BaseOffsets, PositionsAndBaseOffsets };
+
 /// The answer to a handle move or a relax step: the positions of movable_vertices() (Float32
-/// x, y, z), the server's time, and for method nonlinear whether the iteration is finished and
-/// how many iterations the call made.
+/// x, y, z) and the base's row offsets (x, y, z per basis row of the region's kernel), each
+/// when asked for, the server's time, and for method nonlinear whether the iteration is finished
+/// and how many iterations the call made.
 struct Frame {
   std::vector<float> positions;
+  std::vector<float> base_offsets;
   double ms = 0.0;
   bool converged = true;
   int iterations = 0;
@@ -95,16 +103,17 @@ public:
   /// status: it learns of the end of a job at once, without polling fast).
   void wait_for(std::chrono::milliseconds timeout);
 
-  /// Moves handle j (live: not in the history until commit()). Returns the positions of
-  /// movable_vertices(), in that order. Method nonlinear iterates for frame_budget_ms. With
-  /// `answer` false nothing is computed now (a client that evaluates its own frames: the page)
-  /// and the Frame holds no positions; the frame is computed when something reads the shape
-  /// (a pick, the positions, an export, the next answered move).
-  Frame set_transform(int handle, const Transform& transform, bool answer = true);
+  /// Moves handle j (live: not in the history until commit()). Returns what `answer` asks for.
+  /// Method nonlinear iterates for frame_budget_ms. With FrameAnswer::None nothing is computed
+  /// now (a client that evaluates its own linear frames: the page) and the Frame holds nothing;
+  /// the frame is computed when something reads the shape (a pick, the positions, an export, the
+  /// next answered move). Base offsets for the energy blended-motions throw InvalidArgument.
+  Frame set_transform(int handle, const Transform& transform,
+                      FrameAnswer answer = FrameAnswer::Positions);
   /// Method nonlinear: iterates for at most `budget_ms` more under the live transforms (the
-  /// page calls it while the user pauses, until converged). Method linear: the positions as
-  /// they are, converged.
-  Frame relax(double budget_ms);
+  /// page calls it while the user pauses, until converged). Method linear: the frame as it is,
+  /// converged. Answers as set_transform() does, but never nothing.
+  Frame relax(double budget_ms, FrameAnswer answer = FrameAnswer::Positions);
   /// Records the live transforms as a snapshot (the end of a drag). No-op when nothing changed.
   void commit();
   bool undo(); ///< false when there is nothing to undo
@@ -132,8 +141,8 @@ public:
   /// The vertices that can move under the current region (sorted), as ids.
   std::vector<std::uint32_t> movable_vertices() const;
   /// The current region's frame as data (multires/frame_export.h), for a page that evaluates the
-  /// frames of a drag itself. Throws Busy without a region or while a job runs, and when the
-  /// region's method is nonlinear with an energy that iterates (all but blended-motions).
+  /// frames of a drag itself (for an energy that iterates, with the row offsets the frames
+  /// answer). Throws Busy without a region or while a job runs.
   FrameExport frame_export() const;
   /// The base surface (remeshed) under the current transforms, its faces, and its vertex areas
   /// over their mean (the "coloured by vertex area" view).

@@ -13,10 +13,13 @@
 //                        frame (X-Frame-Ms), drag_round_trip_ms, the request's send to its answer
 //                        read, drag_apply_ms, the positions and normals applied in the page;
 //   bake_ms              a new stroke after a move (the edited shape baked, a new region) until paintable;
-//                        With method linear and blended motions the page evaluates the frames itself
-//                        (web/kernel.js):
-//                        drag_kernel_ms is that evaluation, and there is no server part or round trip
-//                        (--server-frames: the server's frames instead); kernel_bytes, the region's
+//                        The page evaluates the frames itself (web/kernel.js) once the region's
+//                        kernel is here: drag_kernel_ms is that evaluation (--server-frames: the
+//                        server's frames instead). With method linear and blended motions there is
+//                        no server part or round trip; with the energies that iterate the server
+//                        answers the moves with its base offsets, which the page adds from then on:
+//                        drag_server_ms and drag_round_trip_ms are those answers' (the age of the
+//                        nonlinear part of a frame shown); kernel_bytes, the region's
 //                        kernel, and kernel_after_mouseup_ms, its arrival after the handle stroke's
 //                        mouse-up (compare mouseup_to_gizmo_ms);
 //   bytes_per_frame      the transform answer's size; support_vertices, the region's support;
@@ -115,9 +118,9 @@ try {
     const [ms, bytes, server, trip, apply, kernel] = keys.map((k) => mm[k].slice(before[k].length));
     return { ms, bytes, server, trip, apply, kernel };
   };
-  // Method linear and blended motions: the page evaluates the drag's frames once the region's
-  // kernel is here.
-  if (!serverFrames && ['linear', 'blended-motions'].includes(args.method ?? 'linear'))
+  // The page evaluates the drag's frames once the region's kernel is here (for the energies that
+  // iterate, with the server's first base offsets).
+  if (!serverFrames)
     await page.waitForFunction(() => window.remora.kernelFrame([]) !== null, null, { timeout: 120000 }).catch(() => {});
   const afterKernel = await marks();
   const kernelMark = afterKernel.kernel.at(-1);

@@ -120,8 +120,10 @@ const pageVsServer = (page) => page.evaluate(async () => {
 });
 
 /// The method switch after a move: nonlinear keeps the transforms and bends the support
-/// otherwise, converged; a drag under it is answered frame by frame and, once the pointer rests,
-/// relaxed until the server says converged, the page holding the server's positions; blended
+/// otherwise, converged; a drag under it is shown by the page's own frames (the kernel corrected
+/// by the server's base offsets, which answer every move) and, once the pointer rests, relaxed
+/// until the server says converged, the page holding the server's positions and its own frame
+/// agreeing with them; blended
 /// motions keep the move too; linear again gives back the linear shape.
 async function methodAfterMove(page, c, edit) {
   const s0 = await c.json('status');
@@ -142,8 +144,15 @@ async function methodAfterMove(page, c, edit) {
         `the method nonlinear after a move keeps the transforms and converges (${JSON.stringify(s1.nonlinear)})`);
   check(change > 1e-6 && outside === 0, `nonlinear bends the support otherwise (by ${change.toExponential(2)}), nothing outside it moves (${outside})`);
   check(await pageVsServer(page) === 0, 'the page shows the nonlinear positions');
-  // A drag under nonlinear.
-  const frames0 = (await remora(page, 'marks')).drag.length;
+  // A drag under nonlinear, shown by the page's own frames once the region's corrected kernel
+  // and its first base offsets are here.
+  const identity = [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0];
+  for (const end = Date.now() + 60000; Date.now() < end;) {
+    if (await page.evaluate((t) => window.remora.kernelFrame([t]) !== null, identity)) break;
+    await page.waitForTimeout(200);
+  }
+  const marks0 = await remora(page, 'marks');
+  const frames0 = marks0.drag.length;
   await page.click('button[data-mode="translate"]');
   const pivot = await remora(page, 'pivot');
   const centre = await page.evaluate((q) => window.remora.projectPoint(...q), pivot);
@@ -153,9 +162,26 @@ async function methodAfterMove(page, c, edit) {
   const s2 = await c.json('status');
   const frames = (await remora(page, 'marks')).drag.length - frames0;
   const off = await pageVsServer(page);
-  check(frames > 0 && s2.nonlinear?.converged === true && off < 1e-6,
-        `a nonlinear drag: ${frames} frames answered, then relaxed until converged (${JSON.stringify(s2.nonlinear)}), ` +
-        `the page holding the server's positions (off by ${off})`);
+  const marks2 = await remora(page, 'marks');
+  const localFrames = marks2.dragKernel.length - marks0.dragKernel.length;
+  const offsetAnswers = marks2.dragTrip.length - marks0.dragTrip.length;
+  check(frames > 0 && localFrames === frames && offsetAnswers > 0 && s2.nonlinear?.converged === true && off < 1e-6,
+        `a nonlinear drag: ${frames} frames, ${localFrames} of them the page's own, ${offsetAnswers} base offsets answered, ` +
+        `then relaxed until converged (${JSON.stringify(s2.nonlinear)}), the page holding the server's positions (off by ${off})`);
+  // The page's frame under the live transforms, with the offsets of the server's converged frame,
+  // is the server's frame.
+  const corrected = await page.evaluate(async (t) => {
+    const local = window.remora.kernelFrame([t]);
+    const movable = new Uint32Array(await (await fetch('api/movable')).arrayBuffer());
+    const server = new Float32Array(await (await fetch('api/mesh/positions')).arrayBuffer());
+    if (!local || local.length !== 3 * movable.length) return Infinity;
+    let worst = 0;
+    movable.forEach((v, i) => { for (let k = 0; k < 3; ++k) worst = Math.max(worst, Math.abs(local[3 * i + k] - server[3 * v + k])); });
+    return worst;
+  }, s2.transforms[0]);
+  const diagonal = boxDiagonal(edit.rest);
+  check(corrected <= 1e-5 * diagonal, `the page's nonlinear frame with the server's base offsets is the server's ` +
+        `(off by ${corrected.toExponential(2)}, bound ${(1e-5 * diagonal).toExponential(2)})`);
   // Blended motions: method nonlinear with that energy, the same transforms, no iteration.
   await page.selectOption('#method', 'blended-motions');
   await ready(page);
@@ -327,10 +353,15 @@ async function regionInPause(page, log, c, site) {
 /// that rotates by 40 degrees about z through the handle's centre and scales anisotropically:
 /// every coordinate within 1e-5 of the mesh's bounding diagonal. Then back to the map `dragged`
 /// (12 numbers). `rest`: the positions at rest; c: the API client.
+/// The diagonal of the bounding box of positions (x, y, z per vertex).
+function boxDiagonal(positions) {
+  const lo = [Infinity, Infinity, Infinity], hi = [-Infinity, -Infinity, -Infinity];
+  for (let i = 0; i < positions.length; ++i) { lo[i % 3] = Math.min(lo[i % 3], positions[i]); hi[i % 3] = Math.max(hi[i % 3], positions[i]); }
+  return Math.hypot(...hi.map((h, i) => h - lo[i]));
+}
+
 export async function kernelAgrees(page, c, rest, region, dragged, what = 'the page\'s frame') {
-  const lo = [Infinity, Infinity, Infinity], hi = [-Infinity, -Infinity, -Infinity], o = [0, 0, 0];
-  for (let i = 0; i < rest.length; ++i) { lo[i % 3] = Math.min(lo[i % 3], rest[i]); hi[i % 3] = Math.max(hi[i % 3], rest[i]); }
-  const diagonal = Math.hypot(...hi.map((h, i) => h - lo[i]));
+  const diagonal = boxDiagonal(rest), o = [0, 0, 0];
   for (const v of region.handles[0]) for (let k = 0; k < 3; ++k) o[k] += rest[3 * v + k] / region.handles[0].length;
   const a = (40 * Math.PI) / 180, cs = Math.cos(a), sn = Math.sin(a);
   const M = [[1.2 * cs, -sn, 0], [1.2 * sn, cs, 0], [0, 0, 0.9]];

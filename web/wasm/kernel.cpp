@@ -4,8 +4,8 @@
 // clang for wasm32 (no C library: each instance's memory is laid out by the JavaScript).
 #include "remora/multires/frame_replay.h"
 
-static_assert(sizeof(remora::FrameReplay) == 24 * 4,
-              "web/kernel.js writes FrameReplay as 24 words");
+static_assert(sizeof(remora::FrameReplay) == 25 * 4,
+              "web/kernel.js writes FrameReplay as 25 words");
 
 /// The drawn mesh's vertex normals that a drag changes, with three.js's formula (web/normals.js,
 /// updateNormals(): the sum over a vertex's faces of (c − b) × (a − b), normalized; a zero sum

@@ -333,6 +333,7 @@ public:
 
 private:
   friend FrameExport frame_export(const Editor& editor); // multires/frame_export.h
+  friend std::vector<float> frame_base_offsets(const Editor& editor);
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

@@ -6,6 +6,7 @@
 
 #include "remora/common/error.h"
 #include "remora/multires/editor_detail.h"
+#include "remora/multires/frame_replay.h"
 
 namespace remora {
 
@@ -41,17 +42,15 @@ std::vector<std::uint32_t> as_unsigned(const std::vector<int>& v) {
 FrameExport frame_export(const Editor& editor) {
   const Editor::Impl& m = *editor.impl_;
   if (!m.region) throw InvalidArgument("no region yet: call set_region() first");
-  const bool blended = m.options.method == EditMethod::Nonlinear &&
-                       m.options.nonlinear.energy == NonlinearEnergy::BlendedMotions;
-  if (m.options.method != EditMethod::Linear && !blended)
-    throw InvalidArgument("the frame is exported for method linear and the nonlinear energy "
-                          "blended-motions only: the other energies' frames iterate");
+  const bool nonlinear = m.options.method == EditMethod::Nonlinear;
+  const bool blended = nonlinear && m.options.nonlinear.energy == NonlinearEnergy::BlendedMotions;
   const RegionState& r = *m.region;
   const NormalPlan& plan = r.affected;
   const FrameDetails& details = r.details;
   FrameExport out;
   out.handles = r.handles;
   out.blended = blended;
+  out.corrected = nonlinear && !blended;
 
   // Faces: the normals' faces first (ring indexes them as they are), then the decode's.
   LocalIds face_ids(m.topology.faces.size()),
@@ -98,6 +97,36 @@ FrameExport frame_export(const Editor& editor) {
     for (const double x : res) out.residuals.push_back(static_cast<float>(x));
   for (const Eigen::Vector3d& o : details.offsets)
     for (int c = 0; c < 3; ++c) out.offsets.push_back(static_cast<float>(o[c]));
+  return out;
+}
+
+std::vector<float> frame_base_offsets(const Editor& editor) {
+  const Editor::Impl& m = *editor.impl_;
+  if (!m.region) throw InvalidArgument("no region yet: call set_region() first");
+  if (m.options.method == EditMethod::Nonlinear &&
+      m.options.nonlinear.energy == NonlinearEnergy::BlendedMotions)
+    throw InvalidArgument("the energy blended-motions has no row offsets: its frames blend the "
+                          "handles' motions, not the basis functions");
+  const RegionState& r = *m.region;
+  if (r.dirty)
+    throw InvalidArgument("a transform was set after the last frame: call positions() first");
+  std::vector<double> transforms;
+  for (const Transform& t : r.transforms)
+    for (int row = 0; row < 3; ++row)
+      for (int col = 0; col < 4; ++col) transforms.push_back(t(row, col));
+  const auto columns = static_cast<std::size_t>(r.basis.cols());
+  const auto handles = static_cast<std::uint32_t>(r.handles);
+  std::vector<float> out(3 * r.free_vertices.size());
+  std::vector<float> row(columns);
+  for (std::size_t i = 0; i < r.free_vertices.size(); ++i) {
+    const double* b = r.basis.data() + i * columns; // row-major
+    for (std::size_t c = 0; c < columns; ++c) row[c] = static_cast<float>(b[c]);
+    double p[3];
+    replay_blend_row(row.data(), handles, transforms.data(), p);
+    for (int c = 0; c < 3; ++c)
+      out[3 * i + static_cast<std::size_t>(c)] =
+          static_cast<float>(r.frame(r.free_vertices[i], c) - p[c]);
+  }
   return out;
 }
 

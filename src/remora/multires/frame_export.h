@@ -1,7 +1,7 @@
 // The current region's frame (frame.h: blend, normals, Phong decode) as data, for a client that
-// evaluates the frames of method linear and of the energy blended-motions itself: the browser page does, so that a drag needs no
-// round trip (web/kernel.js; docs/server.md, `GET /api/region/kernel`). Single precision, in a
-// local numbering of the base: only the base vertices and faces a frame reads.
+// evaluates a drag's frames itself: the browser page does, so that a drag needs no round trip
+// (web/kernel.js; docs/server.md, `GET /api/region/kernel`). Single precision, in a local
+// numbering of the base: only the base vertices and faces a frame reads.
 //
 // A client's frame, for transforms T_j = [M_j | t_j] (j < handles), with C the (3 + 4h) × 3
 // matrix [I; M_0ᵀ; t_0ᵀ; ...] of editor.h:
@@ -9,7 +9,11 @@
 //     vertices of handle j (handle_local[handle_begin[j] .. handle_begin[j + 1])). With
 //     `blended` (method nonlinear, energy blended-motions) the free rows are instead the blend
 //     of motion_blend.h, the weights w_j being the basis rows' columns 3 + 4j + 3 and the pivots
-//     o_j the centroids of the handles' rest positions.
+//     o_j the centroids of the handles' rest positions. With `corrected` (method nonlinear, an
+//     energy that iterates) each free row adds the row offsets of frame_base_offsets(), which
+//     the server computes with its frames: under the transforms of those offsets the client's
+//     base is the server's nonlinear base, and under others it is that base plus the linear
+//     blend's change since (exact for the linear method, first order for the nonlinear one).
 //  2. n = rest normals; for normal_vertices[i]: the normalized sum over its faces
 //     ring[ring_begin[i] .. ring_begin[i + 1]) of (x1 − x0) × (x2 − x0), (0, 0, 0) where it
 //     vanishes.
@@ -27,7 +31,8 @@ class Editor;
 
 struct FrameExport {
   int handles = 0;
-  bool blended = false; ///< step 1 blends the handles' motions (motion_blend.h)
+  bool blended = false;   ///< step 1 blends the handles' motions (motion_blend.h)
+  bool corrected = false; ///< step 1 adds the server's row offsets (frame_base_offsets())
   /// n_local × 6: B0's position and unit normal (that of normal_vertices is step 2's to compute)
   std::vector<float> rest;
   std::vector<std::uint32_t> free_local;   ///< per basis row, its local vertex
@@ -44,9 +49,17 @@ struct FrameExport {
   std::vector<float> offsets;                ///< 3 per record, or empty
 };
 
-/// The editor's current region as a FrameExport. Throws InvalidArgument without a region or
-/// when the editor's method is nonlinear with another energy than blended-motions (whose frames
-/// iterate: they are the server's).
+/// The editor's current region as a FrameExport (`corrected` for method nonlinear with an
+/// energy that iterates). Throws InvalidArgument without a region.
 FrameExport frame_export(const Editor& editor);
+
+/// Per basis row of frame_export() (free base vertex), x, y, z: its base position in the
+/// editor's last frame (Editor::positions(), with or without a budget) minus step 1's blend of
+/// the single-precision basis under the current transforms (replay_blend_row() of
+/// frame_replay.h: a client's blend plus these offsets gives the last frame's base to the
+/// rounding of the offsets). Zero to round-off for method linear. Throws InvalidArgument without
+/// a region, for the energy blended-motions (whose step 1 is no blend of the basis), or when a
+/// transform was set after the last positions() call.
+std::vector<float> frame_base_offsets(const Editor& editor);
 
 } // namespace remora

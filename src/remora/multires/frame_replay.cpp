@@ -41,26 +41,20 @@ void replay_blend(const FrameReplay& f, const double* transforms) {
 
 void replay_blend_rows(const FrameReplay& f, const double* transforms, uint32_t begin,
                        uint32_t end) {
-  // Basis row i · C, C = [I; M_0ᵀ; t_0ᵀ; ...]: the identity's three columns, then per handle
-  // w · [M_j | t_j] rows, summed in the order of the columns.
   const uint32_t columns = f.columns;
   for (uint32_t i = begin; i < end; ++i) {
-    const float* b = f.basis + uint64_t(i) * columns;
-    double px = b[0], py = b[1], pz = b[2];
-    for (uint32_t j = 0; j < f.handles; ++j) {
-      const double* t = transforms + 12 * j;
-      const float* w = b + 3 + 4 * j;
-      for (uint32_t k = 0; k < 4; ++k) {
-        const double wk = w[k];
-        px += wk * t[k];
-        py += wk * t[4 + k];
-        pz += wk * t[8 + k];
-      }
+    double p[3];
+    replay_blend_row(f.basis + uint64_t(i) * columns, f.handles, transforms, p);
+    if (f.row_offsets) {
+      const float* d = f.row_offsets + 3 * uint64_t(i);
+      p[0] += d[0];
+      p[1] += d[1];
+      p[2] += d[2];
     }
     double* out = f.x + 6 * uint64_t(f.free_local[i]);
-    out[0] = px;
-    out[1] = py;
-    out[2] = pz;
+    out[0] = p[0];
+    out[1] = p[1];
+    out[2] = p[2];
   }
 }
 

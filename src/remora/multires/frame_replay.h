@@ -16,7 +16,7 @@
 namespace remora {
 
 /// The arrays of a FrameExport (same names, same shapes) and the frame's working memory. Every
-/// field is 4 bytes on wasm32, in this order: web/kernel.js writes the struct as 24 words.
+/// field is 4 bytes on wasm32, in this order: web/kernel.js writes the struct as 25 words.
 /// The caller's out array holds 3 (max record_slot + 1) floats; free_local and handle_local
 /// name different vertices (a thread may move the handles while another blends rows).
 struct FrameReplay {
@@ -47,10 +47,34 @@ struct FrameReplay {
   /// the others keep their rest values.
   double* x = nullptr;
   double* cross = nullptr; ///< 3 per ring face: step 2's cross products
+  /// 3 per basis row, added to step 1's blend: frame_base_offsets() of a `corrected` export
+  /// (frame_export.h), or null.
+  const float* row_offsets = nullptr;
 };
 
-/// Step 1, linear: x[free_local[i]] = basis row i · C, with C = [I; M_0ᵀ; t_0ᵀ; ...] built
-/// from `transforms`, 12 doubles per handle (the rows of [M_j | t_j]).
+/// Basis row `b` (3 + 4 handles floats) · C, C = [I; M_0ᵀ; t_0ᵀ; ...] from `transforms` (12
+/// doubles per handle): the identity's three columns, then per handle w · [M_j | t_j] rows, summed
+/// in the order of the columns. The client's step 1 and frame_base_offsets() both use it, so that
+/// the offsets cancel the client's blend exactly.
+inline void replay_blend_row(const float* b, uint32_t handles, const double* transforms,
+                             double p[3]) {
+  p[0] = b[0];
+  p[1] = b[1];
+  p[2] = b[2];
+  for (uint32_t j = 0; j < handles; ++j) {
+    const double* t = transforms + 12 * j;
+    const float* w = b + 3 + 4 * j;
+    for (uint32_t k = 0; k < 4; ++k) {
+      const double wk = w[k];
+      p[0] += wk * t[k];
+      p[1] += wk * t[4 + k];
+      p[2] += wk * t[8 + k];
+    }
+  }
+}
+
+/// Step 1, linear: x[free_local[i]] = basis row i · C (replay_blend_row()), plus row_offsets[i]
+/// when there are row offsets; `transforms` holds 12 doubles per handle (the rows of [M_j | t_j]).
 void replay_blend(const FrameReplay& f, const double* transforms);
 
 /// Step 1, the handles' own vertices: x[v] = M_j rest[v] + t_j.
