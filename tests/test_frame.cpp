@@ -407,9 +407,10 @@ double replay_error(const std::vector<float>& replay, const Eigen::MatrixXd& p,
 }
 
 // Method nonlinear (rotated-laplacian): the linear replay plus the row offsets of the server's
-// last frame is that frame, to single precision; under a handle turned 2° further it is the
-// converged frame there to first order (far closer than the linear frame); linear's offsets
-// vanish to round-off; stale offsets and blended motions are refused.
+// last frame is that frame, to single precision; under a handle turned 2° further it is far
+// closer to the converged frame there than the linear frame is (its error grows with the change,
+// not with the whole turn); linear's offsets vanish to round-off; stale offsets and blended
+// motions are refused.
 TEST(FrameExport, TheServersRowOffsetsMakeTheLinearReplayTheNonlinearFrame) {
   for_each_export_case(
       [](Editor& editor, const std::vector<Transform>& transforms, DetailMode mode) {

@@ -24,7 +24,7 @@ const showUi = params.get('ui') !== '0';
 if (!showUi) document.body.classList.add('no-ui');
 for (const id of ['show-base', 'show-wire', 'show-mesh', 'show-edges'])
   if (params.has(id)) $(id).checked = params.get(id) === '1';
-// Not for rendering: page-frames=0, the drags' frames from the server for method linear too
+// Not for rendering: page-frames=0, the drags' frames from the server for every method
 // (web/kernel.js evaluates them in the page otherwise).
 const pageFrames = params.get('page-frames') !== '0';
 // Not for rendering: kernel=js, the page's frames evaluated in JavaScript even where kernel.wasm
@@ -83,6 +83,7 @@ async function sync(s, { fit = false, labelsKnown = false, keepGizmo = false } =
   state.held.positions = s.positions_id;
   const regionChanged = fresh || changed(s.region_id, state.held.region);
   if (regionChanged) await fetchRegion(s, labelsKnown && !fresh);
+  else if (moved) resyncKernel(); // undo, redo: the region's transforms changed under its kernel
   state.transforms = (s.transforms || []).map(rowsToMatrix);
   if (fit) panels.fitRadius(view.fitCamera(cameraParam));
   showHandleButtons();
@@ -142,17 +143,26 @@ function loadKernel(s) {
     releaseKernel(kernel?.data);
     kernel = { regionId, method, data, out: new Float32Array(3 * movable.length), synced: !data.corrected };
     state.marks.kernel.push({ at: performance.now(), bytes: buffer.byteLength });
-    // A corrected kernel's first offsets: a relax step (nothing moves where it has converged).
-    if (data.corrected && !frames.pending) frames.submit({ relax: true, offsets: true });
+    resyncKernel();
   }).catch((e) => console.warn(`region kernel: ${e.message}; the server's frames are shown`));
+}
+/// A corrected kernel waits for offsets of the server's current transforms (after its load, an
+/// undo or a redo): a relax step answers them (nothing moves where the iteration has converged).
+function resyncKernel() {
+  if (!kernel?.data.corrected) return;
+  kernel.synced = false;
+  // A waiting move is not replaced: it asks for the offsets itself once the kernel is here.
+  if (!frames.pending) frames.submit({ relax: true, offsets: true, kernel });
 }
 function kernelUsable() {
   return !!kernel && kernel.synced && kernel.regionId === state.held.region && kernel.method === state.method &&
          !!state.movable && kernel.out.length === 3 * state.movable.length &&
          state.selected < kernel.data.handles;
 }
-/// Whether the server's answers should carry base offsets (a corrected kernel of this region).
-const kernelCorrected = () => !!kernel && kernel.data.corrected && kernel.regionId === state.held.region;
+/// Whether the server's answers should carry base offsets (a corrected kernel of this region and
+/// method).
+const kernelCorrected = () => !!kernel && kernel.data.corrected && kernel.regionId === state.held.region &&
+                              kernel.method === state.method;
 const transformRows = () => state.transforms.map(matrixToRows);
 /// The page's frame under the live transforms, shown.
 function showKernelFrame() {
@@ -434,19 +444,20 @@ async function sendFrame(request) {
                                body: JSON.stringify({ handle: request.handle, matrix: request.matrix, answer }) });
   if (!response.ok) throw new ApiError(response.status, 'relax refused');
   const buffer = await bodyBytes(response), floats = new Float32Array(buffer);
-  const rows = Number(response.headers.get('X-Base-Offset-Rows') ?? 0), split = floats.length - 3 * rows;
-  return { moved: floats.subarray(0, split), offsets: rows > 0 ? floats.subarray(split) : null, bytes: buffer.byteLength,
+  const withOffsets = response.headers.has('X-Base-Offset-Rows');
+  const rows = withOffsets ? Number(response.headers.get('X-Base-Offset-Rows')) : 0, split = floats.length - 3 * rows;
+  return { moved: floats.subarray(0, split), offsets: withOffsets ? floats.subarray(split) : null, bytes: buffer.byteLength,
            ms: parseFloat(response.headers.get('X-Frame-Ms')), converged: response.headers.get('X-Converged') !== '0' };
 }
 let lastMove = 0, relaxTimer = null;
-/// A corrected kernel takes the answer's base offsets; a frame the page showed is shown again
-/// under the live transforms with them.
+/// A corrected kernel takes the answer's base offsets (those of the kernel the request was sent
+/// with); after the drag's last move the page's frame is shown again with them.
 function receiveOffsets(result, request) {
-  if (!result.offsets || !kernelCorrected() || !setRowOffsets(kernel.data, result.offsets)) return;
+  if (!result.offsets || request.kernel !== kernel || !kernelCorrected() || !setRowOffsets(kernel.data, result.offsets)) return;
   kernel.synced = true;
   if (!request.local || !kernelUsable()) return;
   const received = performance.now();
-  showKernelFrame();
+  if (!frames.pending) showKernelFrame();
   state.marks.dragBytes.push(result.bytes);
   state.marks.dragServer.push(result.ms);
   state.marks.dragTrip.push(received - request.sent);
@@ -459,7 +470,9 @@ const frames = new Coalescer(sendFrame, (result, request) => {
   if (!state.movable || result.moved.length !== 3 * state.movable.length) return;
   state.frameMs = result.ms;
   const received = performance.now();
-  view.applyMoved(state.movable, result.moved);
+  // A move after the request was sent is shown already by the page's frame: keep it.
+  if (lastMove > request.sent && kernelUsable()) showKernelFrame();
+  else view.applyMoved(state.movable, result.moved);
   if (!request.relax && !request.last) {
     const done = performance.now();
     state.marks.drag.push(done - request.t0);
@@ -479,7 +492,7 @@ function relaxSoon() {
   const wait = Math.max(0, lastMove + RELAX_PAUSE_MS - performance.now());
   relaxTimer = setTimeout(() => {
     relaxTimer = null;
-    if (!frames.pending && performance.now() - lastMove >= RELAX_PAUSE_MS) frames.submit({ relax: true, offsets: kernelCorrected() });
+    if (!frames.pending && performance.now() - lastMove >= RELAX_PAUSE_MS) frames.submit({ relax: true, offsets: kernelCorrected(), kernel });
     else if (!frames.pending) relaxSoon();
   }, wait);
 }
@@ -502,7 +515,7 @@ gizmo.addEventListener('dragging-changed', (event) => {
   const handle = state.selected, last = draggedLocally;
   task(async () => {
     // The page showed its own frames: the drag ends on the server's (the reference).
-    if (last) frames.submit({ handle, matrix: matrixToRows(state.transforms[handle]), t0: performance.now(), last: true, offsets: kernelCorrected() });
+    if (last) frames.submit({ handle, matrix: matrixToRows(state.transforms[handle]), t0: performance.now(), last: true, offsets: kernelCorrected(), kernel });
     await frames.idle();
     try { await post('commit'); state.status = await json('status'); panels.showStats(state.status, state.frameMs); } catch (e) { /* shown */ }
     if (baseShown()) await showBase(false);
@@ -518,7 +531,7 @@ gizmo.addEventListener('objectChange', () => {
   lastMove = performance.now();
   const local = localFrame(lastMove);
   draggedLocally ||= local;
-  frames.submit({ handle: state.selected, matrix: matrixToRows(t), t0: lastMove, local, offsets: kernelCorrected() });
+  frames.submit({ handle: state.selected, matrix: matrixToRows(t), t0: lastMove, local, offsets: kernelCorrected(), kernel });
 });
 
 // ---- the base surface ---------------------------------------------------------------------------

@@ -175,11 +175,11 @@ HttpResponse region(Session& session, const HttpRequest& request, const ApiLimit
   return json_response(202, session.status());
 }
 
-/// A frame's answer as Float32: the positions, then the base's row offsets, each when asked
-/// for; its figures in headers: X-Frame-Ms (the server's time), X-Converged (1, or 0 while method
-/// nonlinear still iterates), X-Iterations, and with offsets X-Base-Offset-Rows (their rows, 3
-/// floats each, at the end of the body).
-HttpResponse frame_response(const Frame& f) {
+/// A frame's answer as Float32: the positions, then the base's row offsets, each when `answer`
+/// asks for them; its figures in headers: X-Frame-Ms (the server's time), X-Converged (1, or 0
+/// while method nonlinear still iterates), X-Iterations, and when offsets are asked for
+/// X-Base-Offset-Rows (their rows, 3 floats each, at the end of the body).
+HttpResponse frame_response(const Frame& f, FrameAnswer answer) {
   HttpResponse r = binary_response(f.positions);
   if (!f.base_offsets.empty())
     r.body.append(reinterpret_cast<const char*>(f.base_offsets.data()),
@@ -187,7 +187,7 @@ HttpResponse frame_response(const Frame& f) {
   r.headers["X-Frame-Ms"] = fmt::format("{:.3f}", f.ms);
   r.headers["X-Converged"] = std::to_string(f.converged ? 1 : 0);
   r.headers["X-Iterations"] = std::to_string(f.iterations);
-  if (!f.base_offsets.empty())
+  if (answer == FrameAnswer::BaseOffsets || answer == FrameAnswer::PositionsAndBaseOffsets)
     r.headers["X-Base-Offset-Rows"] = std::to_string(f.base_offsets.size() / 3);
   return r;
 }
@@ -223,7 +223,8 @@ HttpResponse transform(Session& session, const HttpRequest& request, const ApiLi
         throw BadRequest(fmt::format("matrix[{}]: expected a finite number", 4 * r + c));
       t(r, c) = x.get<double>();
     }
-  HttpResponse r = frame_response(session.set_transform(j.at("handle").get<int>(), t, answer));
+  HttpResponse r =
+      frame_response(session.set_transform(j.at("handle").get<int>(), t, answer), answer);
   if (answer == FrameAnswer::None) {
     r.status = 204;
     r.body.clear();
@@ -299,7 +300,7 @@ HttpResponse relax(Session& session, const HttpRequest& request, const ApiLimits
       throw BadRequest("answer: a relax step answers \"positions\", \"base-offsets\" or "
                        "\"positions-and-base-offsets\"");
   }
-  return frame_response(session.relax(budget, answer));
+  return frame_response(session.relax(budget, answer), answer);
 }
 
 /// A 3-vector of finite numbers at `key`.

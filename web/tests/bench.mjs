@@ -25,7 +25,8 @@
 //   bytes_per_frame      the transform answer's size; support_vertices, the region's support;
 //   kernel_engine        'wasm' (kernel.wasm) or 'js' (--kernel js, or a page built without it);
 //                        kernel_ms_by_engine, the page's frame alone per engine (wasm on two
-//                        threads, wasm1 on one, js), medians of 31 each, interleaved.
+//                        threads, wasm1 on one, js), medians of 31 each, interleaved (a corrected
+//                        kernel, the nonlinear energies that iterate, has one thread: wasm is wasm1).
 // The pointer moves one step per 1/60 s (a browser delivers moves once per display frame). All
 // medians. The last line printed is one JSON object with these keys.
 //

@@ -119,6 +119,24 @@ const pageVsServer = (page) => page.evaluate(async () => {
   return worst;
 });
 
+/// The largest difference between the page's own frame under `transform` (12 numbers; waiting up
+/// to 60 s for the region's kernel and its offsets) and the server's positions.
+async function correctedKernelOff(page, transform) {
+  for (const end = Date.now() + 60000; Date.now() < end;) {
+    if (await page.evaluate((t) => window.remora.kernelFrame([t]) !== null, transform)) break;
+    await page.waitForTimeout(200);
+  }
+  return page.evaluate(async (t) => {
+    const local = window.remora.kernelFrame([t]);
+    const movable = new Uint32Array(await (await fetch('api/movable')).arrayBuffer());
+    const server = new Float32Array(await (await fetch('api/mesh/positions')).arrayBuffer());
+    if (!local || local.length !== 3 * movable.length) return Infinity;
+    let worst = 0;
+    movable.forEach((v, i) => { for (let k = 0; k < 3; ++k) worst = Math.max(worst, Math.abs(local[3 * i + k] - server[3 * v + k])); });
+    return worst;
+  }, transform);
+}
+
 /// The method switch after a move: nonlinear keeps the transforms and bends the support
 /// otherwise, converged; a drag under it is shown by the page's own frames (the kernel corrected
 /// by the server's base offsets, which answer every move) and, once the pointer rests, relaxed
@@ -169,19 +187,19 @@ async function methodAfterMove(page, c, edit) {
         `a nonlinear drag: ${frames} frames, ${localFrames} of them the page's own, ${offsetAnswers} base offsets answered, ` +
         `then relaxed until converged (${JSON.stringify(s2.nonlinear)}), the page holding the server's positions (off by ${off})`);
   // The page's frame under the live transforms, with the offsets of the server's converged frame,
-  // is the server's frame.
-  const corrected = await page.evaluate(async (t) => {
-    const local = window.remora.kernelFrame([t]);
-    const movable = new Uint32Array(await (await fetch('api/movable')).arrayBuffer());
-    const server = new Float32Array(await (await fetch('api/mesh/positions')).arrayBuffer());
-    if (!local || local.length !== 3 * movable.length) return Infinity;
-    let worst = 0;
-    movable.forEach((v, i) => { for (let k = 0; k < 3; ++k) worst = Math.max(worst, Math.abs(local[3 * i + k] - server[3 * v + k])); });
-    return worst;
-  }, s2.transforms[0]);
+  // is the server's frame; after an undo, with the offsets the page asks for again.
   const diagonal = boxDiagonal(edit.rest);
+  const corrected = await correctedKernelOff(page, s2.transforms[0]);
   check(corrected <= 1e-5 * diagonal, `the page's nonlinear frame with the server's base offsets is the server's ` +
         `(off by ${corrected.toExponential(2)}, bound ${(1e-5 * diagonal).toExponential(2)})`);
+  await page.click('#undo');
+  await ready(page);
+  const undone = await c.json('status');
+  const afterUndo = await correctedKernelOff(page, undone.transforms[0]);
+  check(JSON.stringify(undone.transforms) === JSON.stringify(s1.transforms) && afterUndo <= 1e-5 * diagonal,
+        `after an undo the page's nonlinear frame is the server's again (off by ${afterUndo.toExponential(2)})`);
+  await page.click('#redo');
+  await ready(page);
   // Blended motions: method nonlinear with that energy, the same transforms, no iteration.
   await page.selectOption('#method', 'blended-motions');
   await ready(page);
@@ -349,10 +367,6 @@ async function regionInPause(page, log, c, site) {
         `a pause then mouse-up sends nothing more (${before} then ${after}) and shows the manipulator`);
 }
 
-/// The page's own frame (web/kernel.js, single-precision data) against the server's under a map
-/// that rotates by 40 degrees about z through the handle's centre and scales anisotropically:
-/// every coordinate within 1e-5 of the mesh's bounding diagonal. Then back to the map `dragged`
-/// (12 numbers). `rest`: the positions at rest; c: the API client.
 /// The diagonal of the bounding box of positions (x, y, z per vertex).
 function boxDiagonal(positions) {
   const lo = [Infinity, Infinity, Infinity], hi = [-Infinity, -Infinity, -Infinity];
@@ -360,6 +374,10 @@ function boxDiagonal(positions) {
   return Math.hypot(...hi.map((h, i) => h - lo[i]));
 }
 
+/// The page's own frame (web/kernel.js, single-precision data) against the server's under a map
+/// that rotates by 40 degrees about z through the handle's centre and scales anisotropically:
+/// every coordinate within 1e-5 of the mesh's bounding diagonal. Then back to the map `dragged`
+/// (12 numbers). `rest`: the positions at rest; c: the API client.
 export async function kernelAgrees(page, c, rest, region, dragged, what = 'the page\'s frame') {
   const diagonal = boxDiagonal(rest), o = [0, 0, 0];
   for (const v of region.handles[0]) for (let k = 0; k < 3; ++k) o[k] += rest[3 * v + k] / region.handles[0].length;

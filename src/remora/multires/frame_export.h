@@ -13,7 +13,8 @@
 //     energy that iterates) each free row adds the row offsets of frame_base_offsets(), which
 //     the server computes with its frames: under the transforms of those offsets the client's
 //     base is the server's nonlinear base, and under others it is that base plus the linear
-//     blend's change since (exact for the linear method, first order for the nonlinear one).
+//     blend's change since, off by the difference of the nonlinear and the linear responses to
+//     that change.
 //  2. n = rest normals; for normal_vertices[i]: the normalized sum over its faces
 //     ring[ring_begin[i] .. ring_begin[i + 1]) of (x1 − x0) × (x2 − x0), (0, 0, 0) where it
 //     vanishes.
