@@ -15,6 +15,7 @@
 #include "remora/geometry/measures.h"
 #include "remora/geometry/quality.h"
 #include "remora/geometry/selection.h"
+#include "remora/linalg/nested_dissection.h"
 #include "remora/mesh/io.h"
 #include "remora/mesh/primitives.h"
 #include "remora/multires/bake.h"
@@ -313,10 +314,26 @@ TEST(Bake, CarriesTheBasesOrderAndTheRegionsFollowIt) {
   std::sort(distinct.begin(), distinct.end());
   const auto unique = std::unique(distinct.begin(), distinct.end()) - distinct.begin();
   EXPECT_GE(static_cast<double>(unique), 0.9 * static_cast<double>(q.base_order.size()));
+  // The rows that bridge a separator where the patch crossed it are raised into it: every
+  // coupled pair of the new base's rows lies on one root path of the order's tree, and a region
+  // across the patch is cut at the top of its tree, thinner than without the order.
+  ASSERT_EQ(q.base_order_tree, p.base_order_tree);
+  const SparseMatrix pattern = ring_pattern(q.assembler.minus_w(), 2);
+  for (int j = 0; j < pattern.outerSize(); ++j)
+    for (SparseMatrix::InnerIterator it(pattern, j); it; ++it) {
+      int lower = q.base_order[static_cast<std::size_t>(j)],
+          upper = q.base_order[static_cast<std::size_t>(it.row())];
+      if (lower > upper) std::swap(lower, upper);
+      while (lower >= 0 && lower < upper)
+        lower = q.base_order_tree[static_cast<std::size_t>(lower)];
+      ASSERT_EQ(lower, upper) << "rows " << j << " and " << it.row() << " off one root path";
+    }
   baked.editor.set_region(large.support, {large.handle});
   const SolverStats& after = baked.editor.report().solver_stats;
   EXPECT_TRUE(after.keyed_order);
+  EXPECT_TRUE(after.tree_cut);
   EXPECT_GT(after.separator_rows, 0);
+  EXPECT_LT(after.separator_rows, unprepared_separator);
   // A full re-preprocess orders its base afresh.
   BakeOptions full_options;
   full_options.force_full = true;

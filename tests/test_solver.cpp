@@ -299,22 +299,6 @@ void expect_a_balanced_split(const SparseMatrix& a, const Separator& s) {
   EXPECT_GE(std::min(s.rows[0], s.rows[1]), 0.4 * (s.rows[0] + s.rows[1]));
 }
 
-bool is_a_permutation(std::vector<int> keys) {
-  std::sort(keys.begin(), keys.end());
-  for (std::size_t k = 0; k < keys.size(); ++k)
-    if (keys[k] != static_cast<int>(k)) return false;
-  return true;
-}
-
-// The keys of a system's rows in the order of its mesh (the base's order, as the editor gives
-// them).
-std::vector<int> region_keys(const std::vector<int>& mesh_keys, const KHarmonicSystem& s) {
-  std::vector<int> keys(s.free_vertices.size());
-  for (std::size_t r = 0; r < keys.size(); ++r)
-    keys[r] = mesh_keys[static_cast<std::size_t>(s.free_vertices[r])];
-  return keys;
-}
-
 // The block-diagonal matrix [a 0; 0 b].
 SparseMatrix block_diagonal(const SparseMatrix& a, const SparseMatrix& b) {
   std::vector<Eigen::Triplet<double>> t;
@@ -354,6 +338,22 @@ TEST(SplitCholesky, TheSeparatorDecouplesTwoBalancedHalves) {
 }
 
 #ifdef REMORA_WITH_GPL_SOLVERS
+bool is_a_permutation(std::vector<int> keys) {
+  std::sort(keys.begin(), keys.end());
+  for (std::size_t k = 0; k < keys.size(); ++k)
+    if (keys[k] != static_cast<int>(k)) return false;
+  return true;
+}
+
+// The keys of a system's rows in the order of its mesh (the base's order, as the editor gives
+// them).
+std::vector<int> region_keys(const std::vector<int>& mesh_keys, const KHarmonicSystem& s) {
+  std::vector<int> keys(s.free_vertices.size());
+  for (std::size_t r = 0; r < keys.size(); ++r)
+    keys[r] = mesh_keys[static_cast<std::size_t>(s.free_vertices[r])];
+  return keys;
+}
+
 // The base's order (nested_dissection.h) of a region: the rows of one mesh-wide order, as the
 // editor gives them (Editor::prepare_regions). Its tree separator cuts the region into halves that do
 // not couple, and its keys are a postorder of the tree. A forest, shared keys and keys too large
@@ -402,6 +402,85 @@ TEST(SplitCholesky, TheTreeOfANestedDissectionGivesAThinSeparator) {
   std::iota(in_order.begin(), in_order.end(), 0);
   EXPECT_TRUE(tree_separator(path, in_order).part.empty());
   EXPECT_TRUE(tree_separator(s.matrix, std::vector<int>(3, 0)).part.empty()); // wrong count
+}
+
+// Whether positions p and q lie on one root path of `tree` (parent by position).
+bool on_one_root_path(const std::vector<int>& tree, int p, int q) {
+  if (p > q) std::swap(p, q);
+  while (p >= 0 && p < q) p = tree[static_cast<std::size_t>(p)];
+  return p == q;
+}
+
+// A bake's patch across the base's top separator, as new rows bridging two rows on its two
+// sides: raised to common ancestors, every coupled pair of rows lies on one root path of the old
+// tree again, and the tree cut separates the changed pattern. Trees that are not postordered and
+// keys out of range are refused.
+TEST(SplitCholesky, RowsBridgingASeparatorAreRaisedIntoIt) {
+  const Mesh mesh = make_icosphere(5);
+  const KHarmonicAssembler assembler(mesh);
+  const SparseMatrix pattern = ring_pattern(assembler.minus_w(), 2);
+  std::vector<int> keys = nested_dissection_keys(pattern);
+  const std::vector<int> tree = elimination_tree(pattern, keys);
+  const auto n = static_cast<int>(pattern.rows());
+  ASSERT_EQ(tree.size(), static_cast<std::size_t>(n));
+  // Two neighbours of the separator's last row on either side of it (on no common root path).
+  const int top = static_cast<int>(std::max_element(keys.begin(), keys.end()) - keys.begin());
+  std::vector<int> around;
+  for (SparseMatrix::InnerIterator it(pattern, top); it; ++it) around.push_back(int(it.row()));
+  int ends[2] = {-1, -1};
+  for (const int a : around)
+    for (const int b : around)
+      if (ends[0] < 0 && !on_one_root_path(tree, keys[std::size_t(a)], keys[std::size_t(b)]))
+        ends[0] = a, ends[1] = b;
+  ASSERT_GE(ends[0], 0) << "no two rows on either side of the top separator";
+  // Five new rows in a chain from one end to the other, keyed from the nearer end.
+  std::vector<Eigen::Triplet<double>> entries;
+  for (int j = 0; j < n; ++j)
+    for (SparseMatrix::InnerIterator it(pattern, j); it; ++it)
+      entries.emplace_back(static_cast<int>(it.row()), j, 1.0);
+  const int added = 5;
+  std::vector<int> chain = {ends[0]};
+  for (int i = 0; i < added; ++i) {
+    chain.push_back(n + i);
+    const int key = keys[static_cast<std::size_t>(ends[i < 3 ? 0 : 1])];
+    keys.push_back(key);
+  }
+  chain.push_back(ends[1]);
+  for (std::size_t i = 0; i + 1 < chain.size(); ++i) {
+    entries.emplace_back(chain[i], chain[i + 1], 1.0);
+    entries.emplace_back(chain[i + 1], chain[i], 1.0);
+  }
+  for (int i = 0; i < added; ++i) entries.emplace_back(n + i, n + i, 1.0);
+  SparseMatrix changed(n + added, n + added);
+  changed.setFromTriplets(entries.begin(), entries.end());
+  const auto coupled_off_path = [&](const std::vector<int>& k) {
+    int off = 0;
+    for (int j = 0; j < changed.outerSize(); ++j)
+      for (SparseMatrix::InnerIterator it(changed, j); it; ++it)
+        off += !on_one_root_path(tree, k[static_cast<std::size_t>(it.row())],
+                                 k[static_cast<std::size_t>(j)]);
+    return off;
+  };
+  EXPECT_EQ(coupled_off_path(keys), 2); // the chain's middle link, both ways
+  const std::vector<int> carried = keys;
+  const int raised = raise_to_common_ancestors(changed, 1, tree, keys);
+  EXPECT_GT(raised, 0);
+  EXPECT_EQ(coupled_off_path(keys), 0);
+  for (std::size_t v = 0; v < keys.size(); ++v) // only up, to ancestors
+    ASSERT_TRUE(keys[v] >= carried[v] && on_one_root_path(tree, keys[v], carried[v])) << v;
+  const Separator cut = tree_separator(changed, keys);
+  expect_a_balanced_split(changed, cut);
+  EXPECT_LT(cut.separator_rows, std::sqrt(16.0 * (n + added)));
+  std::vector<int> unchanged = nested_dissection_keys(pattern);
+  EXPECT_EQ(raise_to_common_ancestors(assembler.minus_w(), 2, tree, unchanged),
+            0); // nothing to raise
+  // Refused: a parent below its child, a tree that is not a postorder, a key of no position.
+  std::vector<int> three = {0, 1, 2};
+  const SparseMatrix identity = SparseMatrix(Eigen::MatrixXd::Identity(3, 3).sparseView());
+  EXPECT_THROW(raise_to_common_ancestors(identity, 1, {2, -1, 1}, three), InvalidArgument);
+  EXPECT_THROW(raise_to_common_ancestors(identity, 1, {2, -1, -1}, three), InvalidArgument);
+  std::vector<int> beyond = {0, 1, 3};
+  EXPECT_THROW(raise_to_common_ancestors(identity, 1, {2, 2, -1}, beyond), InvalidArgument);
 }
 
 // In the base's order the halves solve as one factor does; keys of the wrong count are refused.

@@ -1,5 +1,7 @@
 #include "remora/linalg/nested_dissection.h"
 
+#include <algorithm>
+#include <numeric>
 #include <string>
 
 #include "remora/common/error.h"
@@ -37,6 +39,75 @@ std::vector<int> nested_dissection_keys(const Eigen::SparseMatrix<double>& a) {
 #else
   return {};
 #endif
+}
+
+int raise_to_common_ancestors(const Eigen::SparseMatrix<double>& graph, int k,
+                              const std::vector<int>& tree, std::vector<int>& keys) {
+  const auto n = static_cast<std::size_t>(graph.rows());
+  const auto m = static_cast<int>(tree.size());
+  if (graph.rows() != graph.cols() || keys.size() != n || k < 1)
+    throw InvalidArgument(
+        "raise_to_common_ancestors: give a square graph, k >= 1 and a key per row");
+  // first[p]: the lowest position of p's subtree, which holds first[p] … p (a postorder).
+  std::vector<int> first(tree.size()), size(tree.size(), 1);
+  std::iota(first.begin(), first.end(), 0);
+  for (int p = 0; p < m; ++p) {
+    const int q = tree[static_cast<std::size_t>(p)];
+    if (q < 0) continue;
+    if (q <= p || q >= m)
+      throw InvalidArgument("raise_to_common_ancestors: a parent below its child in the tree");
+    size[static_cast<std::size_t>(q)] += size[static_cast<std::size_t>(p)];
+    first[static_cast<std::size_t>(q)] =
+        std::min(first[static_cast<std::size_t>(q)], first[static_cast<std::size_t>(p)]);
+  }
+  for (int p = 0; p < m; ++p)
+    if (p - first[static_cast<std::size_t>(p)] + 1 != size[static_cast<std::size_t>(p)])
+      throw InvalidArgument("raise_to_common_ancestors: the tree is not postordered");
+  for (const int key : keys)
+    if (key < 0 || key >= m)
+      throw InvalidArgument("raise_to_common_ancestors: a key is not a position of the tree");
+  const auto on_one_path = [&](int p, int q) {
+    if (p > q) std::swap(p, q);
+    return first[static_cast<std::size_t>(q)] <= p; // q is p or above it
+  };
+  const auto common = [&](int p, int q) {
+    while (p != q && p >= 0 && q >= 0)
+      (p < q ? p : q) = tree[static_cast<std::size_t>(p < q ? p : q)];
+    return p == q ? p : -1; // -1: in two trees
+  };
+  std::vector<int> queue(n), seen(n, -1), frontier, next;
+  std::iota(queue.begin(), queue.end(), 0);
+  std::vector<char> queued(n, 1);
+  int raised = 0;
+  for (std::size_t head = 0; head < queue.size(); ++head) {
+    const int v = queue[head];
+    queued[static_cast<std::size_t>(v)] = 0;
+    seen[static_cast<std::size_t>(v)] = static_cast<int>(head);
+    frontier.assign(1, v);
+    for (int step = 0; step < k; ++step) { // the rows within k steps of v, each once
+      next.clear();
+      for (const int x : frontier)
+        for (Eigen::SparseMatrix<double>::InnerIterator it(graph, x); it; ++it) {
+          const auto u = static_cast<int>(it.row());
+          if (seen[static_cast<std::size_t>(u)] == static_cast<int>(head)) continue;
+          seen[static_cast<std::size_t>(u)] = static_cast<int>(head);
+          next.push_back(u);
+          const int p = keys[static_cast<std::size_t>(v)], q = keys[static_cast<std::size_t>(u)];
+          if (on_one_path(p, q)) continue;
+          const int c = common(p, q);
+          if (c < 0) continue;
+          const int w = p < q ? v : u; // the lower row goes up to the common ancestor
+          keys[static_cast<std::size_t>(w)] = c;
+          ++raised;
+          if (!queued[static_cast<std::size_t>(w)]) {
+            queued[static_cast<std::size_t>(w)] = 1;
+            queue.push_back(w);
+          }
+        }
+      frontier.swap(next);
+    }
+  }
+  return raised;
 }
 
 Eigen::SparseMatrix<double> ring_pattern(const Eigen::SparseMatrix<double>& minus_w, int k) {

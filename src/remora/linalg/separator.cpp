@@ -128,41 +128,6 @@ Separator level_separator(const Sparse& a) {
 
 namespace {
 
-// The elimination tree of `a`'s pattern (lower triangle) with row v at `position[v]` (Liu's
-// algorithm with path compression): parent[k] of position k, -1 at a root. Each position's
-// earlier neighbours are gathered first, so the sweep reads them in sequence.
-std::vector<int> elimination_tree(const Sparse& a, const std::vector<int>& position) {
-  const std::size_t n = position.size();
-  std::vector<int> begin(n + 1, 0);
-  for (int j = 0; j < a.outerSize(); ++j)
-    for (Sparse::InnerIterator it(a, j); it; ++it)
-      if (it.row() > j)
-        ++begin[static_cast<std::size_t>(std::max(position[static_cast<std::size_t>(it.row())],
-                                                  position[static_cast<std::size_t>(j)])) +
-                1];
-  for (std::size_t k = 0; k < n; ++k) begin[k + 1] += begin[k];
-  std::vector<int> earlier(static_cast<std::size_t>(begin[n])),
-      fill(begin.begin(), begin.end() - 1);
-  for (int j = 0; j < a.outerSize(); ++j)
-    for (Sparse::InnerIterator it(a, j); it; ++it)
-      if (it.row() > j) {
-        const int x = position[static_cast<std::size_t>(it.row())],
-                  y = position[static_cast<std::size_t>(j)];
-        earlier[static_cast<std::size_t>(fill[static_cast<std::size_t>(std::max(x, y))]++)] =
-            std::min(x, y);
-      }
-  std::vector<int> parent(n, -1), ancestor(n, -1);
-  for (std::size_t k = 0; k < n; ++k)
-    for (int e = begin[k]; e < begin[k + 1]; ++e)
-      for (int i = earlier[static_cast<std::size_t>(e)]; i != -1 && i < static_cast<int>(k);) {
-        const int next = ancestor[static_cast<std::size_t>(i)];
-        ancestor[static_cast<std::size_t>(i)] = static_cast<int>(k);
-        if (next == -1) parent[static_cast<std::size_t>(i)] = static_cast<int>(k);
-        i = next;
-      }
-  return parent;
-}
-
 // The rows by increasing key, ties by row: counted when the keys are small (a base's order), else
 // sorted.
 std::vector<int> sorted_by_key(const std::vector<int>& keys) {
@@ -215,6 +180,39 @@ std::vector<int> postorder_keys(const std::vector<int>& parent, const std::vecto
   return keys;
 }
 } // namespace
+
+// Each position's earlier neighbours are gathered first, so that the sweep reads them in sequence.
+std::vector<int> elimination_tree(const Sparse& a, const std::vector<int>& position) {
+  const std::size_t n = position.size();
+  std::vector<int> begin(n + 1, 0);
+  for (int j = 0; j < a.outerSize(); ++j)
+    for (Sparse::InnerIterator it(a, j); it; ++it)
+      if (it.row() > j)
+        ++begin[static_cast<std::size_t>(std::max(position[static_cast<std::size_t>(it.row())],
+                                                  position[static_cast<std::size_t>(j)])) +
+                1];
+  for (std::size_t k = 0; k < n; ++k) begin[k + 1] += begin[k];
+  std::vector<int> earlier(static_cast<std::size_t>(begin[n])),
+      fill(begin.begin(), begin.end() - 1);
+  for (int j = 0; j < a.outerSize(); ++j)
+    for (Sparse::InnerIterator it(a, j); it; ++it)
+      if (it.row() > j) {
+        const int x = position[static_cast<std::size_t>(it.row())],
+                  y = position[static_cast<std::size_t>(j)];
+        earlier[static_cast<std::size_t>(fill[static_cast<std::size_t>(std::max(x, y))]++)] =
+            std::min(x, y);
+      }
+  std::vector<int> parent(n, -1), ancestor(n, -1);
+  for (std::size_t k = 0; k < n; ++k)
+    for (int e = begin[k]; e < begin[k + 1]; ++e)
+      for (int i = earlier[static_cast<std::size_t>(e)]; i != -1 && i < static_cast<int>(k);) {
+        const int next = ancestor[static_cast<std::size_t>(i)];
+        ancestor[static_cast<std::size_t>(i)] = static_cast<int>(k);
+        if (next == -1) parent[static_cast<std::size_t>(i)] = static_cast<int>(k);
+        i = next;
+      }
+  return parent;
+}
 
 Separator tree_separator(const Sparse& a, const std::vector<int>& keys) {
   const int n = static_cast<int>(a.rows());

@@ -22,6 +22,12 @@ struct Separator {
 /// cut; the others join one half whole. Empty `part` when no level balances the halves.
 Separator level_separator(const Eigen::SparseMatrix<double>& a);
 
+/// The elimination tree of `a`'s pattern (n × n, lower triangle read) with row v at
+/// `position[v]` (a permutation of 0 … n − 1; Liu's algorithm with path compression): the
+/// parent of each position, −1 at a root. A parent's position is above its children's.
+std::vector<int> elimination_tree(const Eigen::SparseMatrix<double>& a,
+                                  const std::vector<int>& position);
+
 /// The top of the elimination tree of `a` (lower triangle read) with its rows taken by
 /// increasing `keys` (one per row; ties by row), as a separator: the path from the largest
 /// tree's root down its largest children until no child holds more than 60 % of the rows left.

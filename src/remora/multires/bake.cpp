@@ -13,7 +13,9 @@
 
 #include <fmt/format.h>
 
+#include "remora/common/error.h"
 #include "remora/common/timer.h"
+#include "remora/linalg/nested_dissection.h"
 #include "remora/multires/bake_steps.h"
 #include "remora/multires/phong.h"
 
@@ -128,9 +130,10 @@ void update_assembler(const Bake& b, const SpliceMap* map, EditorParts& parts) {
 // The old base's nested-dissection order (Editor::prepare_regions) carried over: a vertex of the
 // old base keeps its key (the order depends on the graph only, and moving a vertex keeps its
 // edges), a patch vertex takes the key of the nearest one that has a key (breadth first). Where
-// the patch crosses a separator of the order, the separator no longer separates there: a region
-// across the patch then gets a long tree path, and its factor is cut at a breadth-first level
-// with the halves in the carried order (docs/solvers.md).
+// the patch crosses a separator of the order, the separator would no longer separate there:
+// the rows that bridge it are raised into it (raise_to_common_ancestors() on the order's
+// elimination tree), so that a region across the patch is still cut at the top of its tree
+// (docs/solvers.md).
 void carry_order(const Bake& b, const SpliceMap* map, EditorParts& parts) {
   if (b.old.base_order.empty()) return;
   const std::size_t n = parts.base.n_vertices();
@@ -150,6 +153,14 @@ void carry_order(const Bake& b, const SpliceMap* map, EditorParts& parts) {
       }
   }
   for (int& k : keys) k = std::max(k, 0); // a component with no old vertex
+  // Where the patch crossed a separator, its rows go up to the separator they bridge.
+  parts.base_order_tree = b.old.base_order_tree;
+  if (!parts.base_order_tree.empty()) try {
+      raise_to_common_ancestors(parts.assembler->minus_w(), b.old.base_order_k,
+                                parts.base_order_tree, keys);
+    } catch (const InvalidArgument&) {
+      parts.base_order_tree.clear(); // not the old order's tree: the keys stay as carried
+    }
   parts.base_order = std::move(keys);
   parts.base_order_k = b.old.base_order_k;
 }

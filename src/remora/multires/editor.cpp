@@ -18,6 +18,7 @@
 #include "remora/geometry/laplacian.h"
 #include "remora/geometry/measures.h"
 #include "remora/linalg/nested_dissection.h"
+#include "remora/linalg/separator.h"
 #include "remora/multires/editor_detail.h"
 
 namespace remora {
@@ -180,6 +181,7 @@ Editor::Editor(const std::function<void(EditorParts&)>& build, EditorOptions opt
     m.base_order.clear();
     m.base_order_k = 0;
   }
+  if (m.base_order.empty()) m.base_order_tree.clear();
   m.index_base_nearest();
 }
 
@@ -216,12 +218,14 @@ void Editor::prepare_regions() {
       m.options.solver.ordering != "amd" || threads < 2)
     return;
   std::vector<int> keys;
+  const Eigen::SparseMatrix<double> pattern = ring_pattern(m.assembler->minus_w(), k);
   try {
-    keys = nested_dissection_keys(ring_pattern(m.assembler->minus_w(), k));
+    keys = nested_dissection_keys(pattern);
   } catch (const NumericalError&) {
     return; // METIS failed: the regions order themselves, as without preparing
   }
   if (keys.empty()) return;
+  m.base_order_tree = elimination_tree(pattern, keys);
   m.base_order = std::move(keys);
   m.base_order_k = k;
 }
@@ -387,7 +391,7 @@ EditorPartsView Editor::parts() const {
   return {m.input,          m.input_positions, m.input_topology, m.filter,        m.smooth,
           m.base,           m.topology,        m.base_rest,      m.base_on_input, m.input_on_base,
           m.negative_edges, m.statistics,      m.report,         *m.assembler,    m.base_normals,
-          m.base_order,     m.base_order_k};
+          m.base_order,     m.base_order_k,    m.base_order_tree};
 }
 
 nlohmann::json to_json(const EditReport& r) {

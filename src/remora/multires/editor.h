@@ -181,9 +181,13 @@ struct EditorParts {
   /// empty: the editor computes them.
   Eigen::MatrixXd base_normals;
   /// A nested-dissection order of B's k-ring graph, a key per vertex (Editor::prepare_regions();
-  /// a bake carries it over); empty when there is none. base_order_k: its k.
+  /// a bake carries it over); empty when there is none. base_order_k: its k. base_order_tree:
+  /// the elimination tree of the k-ring graph the order was made for, by position (separator.h's
+  /// elimination_tree()), on which a bake keeps the carried keys (raise_to_common_ancestors() of
+  /// nested_dissection.h); empty when there is none.
   std::vector<int> base_order;
   int base_order_k = 0;
+  std::vector<int> base_order_tree;
 };
 
 /// The same pieces of an existing editor, read-only (what a bake reads).
@@ -205,6 +209,7 @@ struct EditorPartsView {
   const Eigen::MatrixXd& base_normals;
   const std::vector<int>& base_order;
   int base_order_k;
+  const std::vector<int>& base_order_tree;
 };
 
 struct FrameExport;
