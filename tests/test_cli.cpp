@@ -294,6 +294,24 @@ TEST_F(Cli, BenchSolversAgreeAndRefuseSupportsLargerThanTheMesh) {
   EXPECT_NE(too_big.err.find("too few for a support of 5000"), std::string::npos) << too_big.err;
 }
 
+// `remora bench edit --bake-first`: a move of a smaller region baked locally first, then the
+// regions timed on the baked base; a bad count is a usage error.
+TEST_F(Cli, BenchEditTimesRegionsOnABakedBase) {
+  const fs::path in = dir_ / "sphere.off";
+  write_mesh(in.string(), make_icosphere(4)); // 2,562 vertices
+  const CliRun r = run("bench edit " + in.string() +
+                       " --support 1200 --regions 2 --frames 2 --bake-first 300 --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["bench"]["bake_first"], 300);
+  EXPECT_EQ(j["bench"]["bake_first_kind"], "local");
+  EXPECT_GT(j["bench"]["bake_first_ms"].get<double>(), 0.0);
+  EXPECT_GT(j["bench"]["later_regions_ms_median"]["set_region"].get<double>(), 0.0);
+  EXPECT_GT(j["region"]["free_base_vertices"].get<int>(),
+            300); // the timed region, not the baked one
+  EXPECT_EQ(run("bench edit " + in.string() + " --bake-first -1").exit_code, 2);
+}
+
 // docs/editing.md's examples, run as documented: every ```json block on the bundled bunny, and
 // the quick-flag form of the first one, which must give the same mesh.
 TEST_F(Cli, EditRunsTheDocumentedExamples) {

@@ -1,10 +1,12 @@
 // `remora bench edit`: the editing kernel's timings (docs/benchmarks.md): preprocessing
 // (base surface + remesh), set_region (map, factor, 3 + 4h basis functions, Phong encoding) for a
 // geodesic support of a given number of free base vertices, and the time per frame (blend +
-// decode, no solve) over a sequence of handle moves.
+// decode, no solve) over a sequence of handle moves; with --bake-first, all of it after a local
+// bake of a move of a smaller region around the same seed (the regions then cross the patch).
 #include <algorithm>
 #include <iostream>
 #include <map>
+#include <optional>
 #include <string>
 
 #include <fmt/format.h>
@@ -18,6 +20,7 @@
 #include "remora/geometry/measures.h"
 #include "remora/geometry/selection.h"
 #include "remora/mesh/io.h"
+#include "remora/multires/bake.h"
 #include "remora/multires/editor.h"
 #include "remora/multires/limits.h"
 #include "report.h"
@@ -28,7 +31,7 @@ namespace {
 
 struct BenchEditArgs {
   std::string mesh = std::string(REMORA_REPO_DATA) + "/bunny.ply";
-  int support = 31000, frames = 60, k = 2, threads = 0, regions = 1;
+  int support = 31000, frames = 60, k = 2, threads = 0, regions = 1, bake_first = 0;
   std::string solver, method = "linear", energy = "rotated-laplacian";
   double frame_budget_ms = 6.0;
   bool json = false, no_prepare = false;
@@ -42,6 +45,9 @@ struct BenchEditTimes {
   std::map<std::string, double> frame_parts; ///< medians of blend, normals, decode (nonlinear)
   double converge_ms = 0;                    ///< nonlinear: after the last frame, to converged
   int converge_iterations = 0;
+  std::map<std::string, double> preprocess_parts; ///< base, remesh, base report
+  double bake_ms = 0;                             ///< --bake-first: the bake
+  std::string bake; ///< --bake-first: "local", or why it was a full re-preprocess
 };
 
 /// A geodesic support around the vertex nearest the centroid, sized so that about `support`
@@ -135,7 +141,10 @@ void print_bench_edit(const BenchEditArgs& a, const EditReport& r, const BenchEd
                   {"method", a.method},
                   {"frame_budget_ms", a.frame_budget_ms},
                   {"converge_ms", t.converge_ms},
-                  {"converge_iterations", t.converge_iterations}};
+                  {"converge_iterations", t.converge_iterations},
+                  {"bake_first", a.bake_first},
+                  {"bake_first_ms", t.bake_ms},
+                  {"bake_first_kind", t.bake}};
     std::cout << dump_json(j, 2) << "\n";
     return;
   }
@@ -146,8 +155,12 @@ void print_bench_edit(const BenchEditArgs& a, const EditReport& r, const BenchEd
       "preprocess {:.0f} ms (base {:.0f}, remesh {:.0f}, report {:.0f}); "
       "heap warmed for a region in {:.0f} ms and regions prepared in {:.0f} ms, "
       "as remora serve does\n",
-      t.preprocess_ms, r.milliseconds.at("base"), r.milliseconds.at("remesh"),
-      r.milliseconds.at("base report"), t.warm_ms, t.prepare_ms);
+      t.preprocess_ms, t.preprocess_parts.at("base"), t.preprocess_parts.at("remesh"),
+      t.preprocess_parts.at("base report"), t.warm_ms, t.prepare_ms);
+  if (a.bake_first > 0)
+    std::cout << fmt::format("a move of a region of {} free base vertices baked in {:.0f} ms ({}); "
+                             "the regions below are on the baked base, across its patch\n",
+                             grouped(static_cast<std::size_t>(a.bake_first)), t.bake_ms, t.bake);
   std::cout << fmt::format(
       "set_region {:.0f} ms for {} free base vertices, {} handle base "
       "vertices, k = {} (map {:.0f}, assemble {:.0f}, factor {:.0f}, solve {:.0f}, "
@@ -196,15 +209,28 @@ void run_bench_edit(const BenchEditArgs& a) {
     progress.update(phase, step, steps);
   };
   t0 = Clock::now();
-  Editor editor(mesh, options);
+  std::optional<Editor> edited(std::in_place, mesh, options);
   t.preprocess_ms = ms_since(t0);
+  for (const char* part : {"base", "remesh", "base report"})
+    t.preprocess_parts[part] = edited->report().milliseconds.at(part);
   progress.finish();
   t0 = Clock::now();
-  warm_heap(warm_heap_bytes(editor.base().n_vertices(), a.k));
+  warm_heap(warm_heap_bytes(edited->base().n_vertices(), a.k));
   t.warm_ms = ms_since(t0);
   t0 = Clock::now();
-  if (!a.no_prepare) editor.prepare_regions();
+  if (!a.no_prepare) edited->prepare_regions();
   t.prepare_ms = ms_since(t0);
+  if (a.bake_first > 0) { // a lift of a smaller region around the same seed, baked
+    set_geodesic_region(*edited, a.bake_first);
+    const double diagonal = bounding_box_diagonal(edited->input());
+    edited->set_transform(0, translation(Eigen::Vector3d(0, 0.01 * diagonal, 0)));
+    t0 = Clock::now();
+    BakeResult baked = remora::bake(*edited);
+    t.bake_ms = ms_since(t0);
+    t.bake = baked.report.local ? "local" : "full: " + baked.report.fallback;
+    edited.emplace(std::move(baked.editor));
+  }
+  Editor& editor = *edited;
   t.set_region_ms = set_geodesic_region(editor, a.support);
   const EditReport first = editor.report(); // the later regions' reports replace it
   time_later_regions(editor, a, t);
@@ -259,6 +285,11 @@ void add_bench_edit_command(CLI::App& bench) {
                 "Assemble and order each region by itself, without the rows and the nested "
                 "dissection of the whole base that remora serve prepares "
                 "(Editor::prepare_regions, docs/solvers.md)");
+  cmd->add_option("--bake-first", a->bake_first,
+                  "First move a region of this many free base vertices around the same seed and "
+                  "bake it (multires/bake.h), then time everything on the baked base: regions "
+                  "across the bake's patch (default 0: no bake)")
+      ->check(CLI::NonNegativeNumber);
   cmd->add_flag("--json", a->json, "Print one JSON object");
   cmd->callback([a] { run_bench_edit(*a); });
 }
