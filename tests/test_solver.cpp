@@ -337,6 +337,49 @@ TEST(SplitCholesky, TheSeparatorDecouplesTwoBalancedHalves) {
   EXPECT_TRUE(level_separator(star).part.empty());
 }
 
+// A path of seven rows in a nested-dissection order made by hand (its middle row last, each
+// half's middle before it): elimination_tree() gives that order's tree, and a coupling added
+// from the first row to the last across the middle raises the first row to the root, after
+// which every coupled pair lies on one root path.
+TEST(SplitCholesky, AHandMadeDissectionKeepsItsTreeWhenARowBridgesItsSeparator) {
+  constexpr int n = 7;
+  const std::vector<int> keys = {0, 2, 1, 6, 3, 5, 4}; // row → position
+  const auto path = [](bool bridged) {
+    std::vector<Eigen::Triplet<double>> t;
+    for (int v = 0; v < n; ++v) t.emplace_back(v, v, 2.0);
+    for (int v = 1; v < n; ++v) {
+      t.emplace_back(v, v - 1, -1.0);
+      t.emplace_back(v - 1, v, -1.0);
+    }
+    if (bridged) {
+      t.emplace_back(0, n - 1, -1.0);
+      t.emplace_back(n - 1, 0, -1.0);
+    }
+    SparseMatrix a(n, n);
+    a.setFromTriplets(t.begin(), t.end());
+    return a;
+  };
+  const std::vector<int> tree = elimination_tree(path(false), keys);
+  EXPECT_EQ(tree, (std::vector<int>{2, 2, 6, 5, 5, 6, -1})); // parent by position
+  std::vector<int> same = keys;
+  EXPECT_EQ(raise_to_common_ancestors(path(false), 1, tree, same), 0);
+  EXPECT_EQ(same, keys);
+  std::vector<int> raised = keys;
+  EXPECT_EQ(raise_to_common_ancestors(path(true), 1, tree, raised), 1);
+  EXPECT_EQ(raised, (std::vector<int>{6, 2, 1, 6, 3, 5, 4})); // row 0 joins the separator
+  // Within two steps the bridge couples more pairs; every one ends on one root path.
+  std::vector<int> two = keys;
+  EXPECT_GT(raise_to_common_ancestors(path(true), 2, tree, two), 0);
+  const SparseMatrix a = path(true), a2 = SparseMatrix(a * a);
+  for (int j = 0; j < n; ++j)
+    for (SparseMatrix::InnerIterator it(a2, j); it; ++it) {
+      int p = two[std::size_t(j)], q = two[std::size_t(it.row())];
+      if (p > q) std::swap(p, q);
+      while (p >= 0 && p < q) p = tree[std::size_t(p)];
+      EXPECT_EQ(p, q) << "rows " << j << " and " << it.row();
+    }
+}
+
 #ifdef REMORA_WITH_GPL_SOLVERS
 bool is_a_permutation(std::vector<int> keys) {
   std::sort(keys.begin(), keys.end());

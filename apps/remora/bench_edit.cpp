@@ -1,8 +1,9 @@
 // `remora bench edit`: the editing kernel's timings (docs/benchmarks.md): preprocessing
 // (base surface + remesh), set_region (map, factor, 3 + 4h basis functions, Phong encoding) for a
 // geodesic support of a given number of free base vertices, and the time per frame (blend +
-// decode, no solve) over a sequence of handle moves; with --bake-first, all of it after a local
-// bake of a move of a smaller region around the same seed (the regions then cross the patch).
+// decode, no solve) over a sequence of handle moves; with --bake-first, the regions and frames
+// on the base baked after a move of a smaller region around the same seed (they then cross its
+// patch).
 #include <algorithm>
 #include <iostream>
 #include <map>
@@ -48,14 +49,14 @@ struct BenchEditTimes {
   std::map<std::string, double> preprocess_parts; ///< base, remesh, base report
   double bake_ms = 0;                             ///< --bake-first: the bake
   std::string bake; ///< --bake-first: "local", or why it was a full re-preprocess
+  std::map<std::string, double> bake_parts; ///< --bake-first: the bake report's milliseconds
 };
 
-/// A geodesic support around the vertex nearest the centroid, sized so that about `support`
+/// A geodesic support around `seed` (the vertex nearest the centroid), sized so that about `support`
 /// base vertices are free (times `grow`), and its innermost 3 % as the handle. Returns the
 /// milliseconds of set_region alone (not the selection's).
-double set_geodesic_region(Editor& editor, int support, double grow = 1.0) {
+double set_geodesic_region(Editor& editor, VertexHandle seed, int support, double grow = 1.0) {
   const Mesh& mesh = editor.input();
-  const VertexHandle seed = central_vertex(mesh);
   const double ratio = double(mesh.n_vertices()) / double(editor.base().n_vertices());
   const auto wanted = static_cast<std::size_t>(
       std::min(double(support) * 1.03 * grow, 0.9 * double(editor.base().n_vertices())) * ratio);
@@ -101,12 +102,13 @@ std::vector<double> time_frames(Editor& editor, int count, double budget_ms,
 /// Regions 2 .. a.regions, each 1 % larger than the one before (a stroke painted on), as a
 /// session meets them after its first: medians of set_region and its parts; the first region
 /// set again at the end (from the recent regions, or solved again).
-void time_later_regions(Editor& editor, const BenchEditArgs& a, BenchEditTimes& t) {
+void time_later_regions(Editor& editor, VertexHandle seed, const BenchEditArgs& a,
+                        BenchEditTimes& t) {
   if (a.regions < 2) return;
   std::map<std::string, std::vector<double>> times;
   std::size_t free_before = editor.report().free_base_vertices;
   for (int r = 1; r < a.regions; ++r) {
-    times["set_region"].push_back(set_geodesic_region(editor, a.support, 1.0 + 0.01 * r));
+    times["set_region"].push_back(set_geodesic_region(editor, seed, a.support, 1.0 + 0.01 * r));
     if (editor.report().free_base_vertices <= free_before)
       throw InvalidArgument(fmt::format(
           "bench edit --regions: region {} is no larger than the one before it (the support is "
@@ -120,7 +122,7 @@ void time_later_regions(Editor& editor, const BenchEditArgs& a, BenchEditTimes& 
     std::sort(v.begin(), v.end());
     t.later_regions[part] = v[v.size() / 2];
   }
-  set_geodesic_region(editor, a.support);
+  set_geodesic_region(editor, seed, a.support);
 }
 
 void print_bench_edit(const BenchEditArgs& a, const EditReport& r, const BenchEditTimes& t) {
@@ -144,7 +146,9 @@ void print_bench_edit(const BenchEditArgs& a, const EditReport& r, const BenchEd
                   {"converge_iterations", t.converge_iterations},
                   {"bake_first", a.bake_first},
                   {"bake_first_ms", t.bake_ms},
-                  {"bake_first_kind", t.bake}};
+                  {"bake_first_kind", t.bake},
+                  {"bake_first_parts_ms", t.bake_parts},
+                  {"preprocess_parts_ms", t.preprocess_parts}};
     std::cout << dump_json(j, 2) << "\n";
     return;
   }
@@ -198,6 +202,7 @@ void run_bench_edit(const BenchEditArgs& a) {
   auto t0 = Clock::now();
   const Mesh mesh = read_mesh(a.mesh).mesh;
   t.load_ms = ms_since(t0);
+  const VertexHandle seed = central_vertex(mesh); // the input's ids outlive a bake
   EditorOptions options;
   options.system.k = a.k;
   options.solver.name = a.solver;
@@ -221,19 +226,21 @@ void run_bench_edit(const BenchEditArgs& a) {
   if (!a.no_prepare) edited->prepare_regions();
   t.prepare_ms = ms_since(t0);
   if (a.bake_first > 0) { // a lift of a smaller region around the same seed, baked
-    set_geodesic_region(*edited, a.bake_first);
+    set_geodesic_region(*edited, seed, a.bake_first);
     const double diagonal = bounding_box_diagonal(edited->input());
     edited->set_transform(0, translation(Eigen::Vector3d(0, 0.01 * diagonal, 0)));
     t0 = Clock::now();
     BakeResult baked = remora::bake(*edited);
     t.bake_ms = ms_since(t0);
+    progress.finish();
     t.bake = baked.report.local ? "local" : "full: " + baked.report.fallback;
+    t.bake_parts = baked.report.milliseconds;
     edited.emplace(std::move(baked.editor));
   }
   Editor& editor = *edited;
-  t.set_region_ms = set_geodesic_region(editor, a.support);
+  t.set_region_ms = set_geodesic_region(editor, seed, a.support);
   const EditReport first = editor.report(); // the later regions' reports replace it
-  time_later_regions(editor, a, t);
+  time_later_regions(editor, seed, a, t);
   t.frames = time_frames(editor, a.frames, a.frame_budget_ms, t.frame_parts);
   // The drag stops: the nonlinear iteration goes on to convergence.
   int iterations = 0;

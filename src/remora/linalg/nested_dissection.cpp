@@ -75,34 +75,27 @@ int raise_to_common_ancestors(const Eigen::SparseMatrix<double>& graph, int k,
       (p < q ? p : q) = tree[static_cast<std::size_t>(p < q ? p : q)];
     return p == q ? p : -1; // -1: in two trees
   };
-  std::vector<int> queue(n), seen(n, -1), frontier, next;
-  std::iota(queue.begin(), queue.end(), 0);
-  std::vector<char> queued(n, 1);
+  // One pass: a raise keeps every pair that was on one root path on one (the raised row moves up
+  // its own root path), so a row's pairs, all on one path after its scan, stay so.
+  std::vector<int> seen(n, -1), frontier, next;
   int raised = 0;
-  for (std::size_t head = 0; head < queue.size(); ++head) {
-    const int v = queue[head];
-    queued[static_cast<std::size_t>(v)] = 0;
-    seen[static_cast<std::size_t>(v)] = static_cast<int>(head);
+  for (int v = 0; v < static_cast<int>(n); ++v) {
+    seen[static_cast<std::size_t>(v)] = v;
     frontier.assign(1, v);
     for (int step = 0; step < k; ++step) { // the rows within k steps of v, each once
       next.clear();
       for (const int x : frontier)
         for (Eigen::SparseMatrix<double>::InnerIterator it(graph, x); it; ++it) {
           const auto u = static_cast<int>(it.row());
-          if (seen[static_cast<std::size_t>(u)] == static_cast<int>(head)) continue;
-          seen[static_cast<std::size_t>(u)] = static_cast<int>(head);
+          if (seen[static_cast<std::size_t>(u)] == v) continue;
+          seen[static_cast<std::size_t>(u)] = v;
           next.push_back(u);
           const int p = keys[static_cast<std::size_t>(v)], q = keys[static_cast<std::size_t>(u)];
           if (on_one_path(p, q)) continue;
           const int c = common(p, q);
-          if (c < 0) continue;
-          const int w = p < q ? v : u; // the lower row goes up to the common ancestor
-          keys[static_cast<std::size_t>(w)] = c;
+          if (c < 0) continue;                               // in two trees of the old order
+          keys[static_cast<std::size_t>(p < q ? v : u)] = c; // the lower row goes up
           ++raised;
-          if (!queued[static_cast<std::size_t>(w)]) {
-            queued[static_cast<std::size_t>(w)] = 1;
-            queue.push_back(w);
-          }
         }
       frontier.swap(next);
     }

@@ -27,9 +27,11 @@ std::vector<int> nested_dissection_keys(const Eigen::SparseMatrix<double>& a);
 /// nested_dissection_keys(), which is a postorder), and keys[v] the old position row v stands at,
 /// several rows sharing one where rows were added. Where two coupled rows stand at positions
 /// neither of which is an ancestor of the other (the change crossed a separator), the row at the
-/// lower position is raised to their lowest common ancestor, until every coupled pair lies on one
-/// root path: the old tree's separators then separate the new coupling again, widened by the
-/// raised rows, and tree_separator() cuts at them. Returns how many raisings it made. Throws
+/// lower position is raised to their lowest common ancestor, in one pass over the rows, after
+/// which every coupled pair within one tree of the old order lies on one root path: the old
+/// tree's separators then separate the new coupling again, widened by the raised rows, and
+/// tree_separator() cuts at them (pairs across two trees, which a change joining two components
+/// of the old graph makes, are left). Returns how many raisings it made. Throws
 /// InvalidArgument when the sizes disagree, k < 1, a key is not a position of the tree, or the
 /// tree is not postordered.
 int raise_to_common_ancestors(const Eigen::SparseMatrix<double>& graph, int k,

@@ -134,8 +134,9 @@ void update_assembler(const Bake& b, const SpliceMap* map, EditorParts& parts) {
 // the rows that bridge it are raised into it (raise_to_common_ancestors() on the order's
 // elimination tree), so that a region across the patch is still cut at the top of its tree
 // (docs/solvers.md).
-void carry_order(const Bake& b, const SpliceMap* map, EditorParts& parts) {
-  if (b.old.base_order.empty()) return;
+// Returns the milliseconds of the raise.
+double carry_order(const Bake& b, const SpliceMap* map, EditorParts& parts) {
+  if (b.old.base_order.empty()) return 0.0;
   const std::size_t n = parts.base.n_vertices();
   std::vector<int> keys(n, -1), queue;
   for (std::size_t o = 0; o < b.old.base_order.size(); ++o) {
@@ -153,9 +154,11 @@ void carry_order(const Bake& b, const SpliceMap* map, EditorParts& parts) {
       }
   }
   for (int& k : keys) k = std::max(k, 0); // a component with no old vertex
-  // Where the patch crossed a separator, its rows go up to the separator they bridge.
+  // Where the patch crossed a separator, its rows go up to the separator they bridge (without a
+  // patch the graph is the old one).
   parts.base_order_tree = b.old.base_order_tree;
-  if (!parts.base_order_tree.empty()) try {
+  const auto t0 = Clock::now();
+  if (map && !parts.base_order_tree.empty()) try {
       raise_to_common_ancestors(parts.assembler->minus_w(), b.old.base_order_k,
                                 parts.base_order_tree, keys);
     } catch (const InvalidArgument&) {
@@ -163,6 +166,7 @@ void carry_order(const Bake& b, const SpliceMap* map, EditorParts& parts) {
     }
   parts.base_order = std::move(keys);
   parts.base_order_k = b.old.base_order_k;
+  return ms_since(t0);
 }
 
 // B's vertex normals: the old ones renumbered, and measured again (update_vertex_normals(), the
@@ -222,21 +226,23 @@ auto timed(BakeReport& report, const char* part, F&& f) {
 }
 
 // The steps after the splice, on two threads. The second updates the old editor's assembler to
-// the new base, then the base's vertex statistics and the figures over them from it; it reads the
-// old editor, the new base and the map, and writes parts.assembler and parts.statistics. The
-// first copies the input, mends the correspondence and updates the other figures and the
-// normals. "assembler" is the second thread's wall time, "wait" the first's wait for it (with one
+// the new base, carries the base's order over (raising it where the patch crossed a separator),
+// then the base's vertex statistics and the figures over them from it; it reads the old editor,
+// the new base and the map, and writes parts.assembler, parts.base_order, parts.base_order_tree
+// and parts.statistics, which the first thread does not read. The first copies the input, mends
+// the correspondence and updates the other figures and the normals. "assembler" is the second
+// thread's wall time, "order raise" the raise within it, "wait" the first's wait for it (with one
 // thread the second's work runs inside "wait"). Should the first thread throw, the future's
 // destructor waits for the job, which reads only what outlives it.
 void finish(Bake& b, const PatchMeshes* meshes, const RemeshPatchResult* remeshed,
             const SpliceMap* map, EditorParts& parts) {
   const BaseChange change = timed(b.report, "report", [&] { return base_change(b, map); });
-  double assembler_ms = 0;
+  double assembler_ms = 0, raise_ms = 0;
   VertexFigures figures;
   auto job = std::async(b.options.threads == 1 ? std::launch::deferred : std::launch::async, [&] {
     const auto t0 = Clock::now();
     update_assembler(b, map, parts);
-    carry_order(b, map, parts);
+    raise_ms = carry_order(b, map, parts);
     figures = update_vertex_figures(b.old.statistics, parts.base, change, *parts.assembler,
                                     parts.statistics, b.options.threads);
     assembler_ms = ms_since(t0);
@@ -252,6 +258,7 @@ void finish(Bake& b, const PatchMeshes* meshes, const RemeshPatchResult* remeshe
   parts.report.base_quality.barycentric_area = figures.barycentric_area;
   parts.report.base_symmetry_defect = figures.symmetry_defect;
   b.report.milliseconds["assembler"] = assembler_ms;
+  if (!b.old.base_order.empty()) b.report.milliseconds["order raise"] = raise_ms;
 }
 
 // Step 3's splice and finish().

@@ -181,7 +181,11 @@ Editor::Editor(const std::function<void(EditorParts&)>& build, EditorOptions opt
     m.base_order.clear();
     m.base_order_k = 0;
   }
-  if (m.base_order.empty()) m.base_order_tree.clear();
+  // The tree holds a position for every key (a bake keeps the old tree, whatever the new size).
+  if (m.base_order.empty() || std::any_of(m.base_order.begin(), m.base_order.end(), [&](int key) {
+        return key < 0 || key >= static_cast<int>(m.base_order_tree.size());
+      }))
+    m.base_order_tree.clear();
   m.index_base_nearest();
 }
 
