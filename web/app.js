@@ -5,11 +5,11 @@
 // view.js draws, api.js talks to the server, picking.js asks it what is under the pointer,
 // panels.js is the panel and the keyboard.
 import * as THREE from 'three';
-import { ApiError, api, binary, bodyBytes, compactIds, json, message, post, task, waitUntilReady, work } from './api.js';
+import { ApiError, api, binary, compactIds, json, message, post, task, waitUntilReady, work } from './api.js';
 import * as view from './view.js';
 import { FIXED, FREE } from './view.js';
 import { Coalescer, faceNormal, pick } from './picking.js';
-import { evaluateKernel, parseKernel, releaseKernel, setRowOffsets } from './kernel.js';
+import { RegionKernel, methodOf, sendFrame } from './drag_frames.js';
 import { engine, loadEngine } from './engine.js';
 import * as panels from './panels.js';
 
@@ -101,8 +101,7 @@ async function fetchRegion(s, labelsKnown) {
       region.handles.forEach((h, j) => { for (const v of h) state.labels[v] = j; });
       state.k = region.k;
       panels.setK(region.k);
-      state.method = region.energy === 'blended-motions' && region.method === 'nonlinear'
-        ? 'blended-motions' : region.method ?? 'linear';
+      state.method = methodOf(region) ?? 'linear';
       panels.setMethod(state.method);
     }
     state.handleCount = Math.max(1, region?.handles.length ?? 0);
@@ -119,30 +118,22 @@ async function fetchRegion(s, labelsKnown) {
   loadKernel(s);
 }
 
-// ---- the frames of a drag in the page (kernel.js) -----------------------------------------------
-// A drag is evaluated here, from the region's kernel fetched once after the region is ready.
-// Under method linear and the energy blended-motions the server is sent every map (without an
-// answer) and answers the last one of the drag, whose positions the page then shows. Under the
-// energies that iterate the kernel is corrected: every map is answered with the base offsets of
-// the server's nonlinear frame, which the page adds to its linear blend from then on, so each
-// display frame is the server's last nonlinear base plus the linear change since; the drag ends,
-// and the pauses relax, on the server's positions. Until the kernel (and a corrected kernel's
-// first offsets) is here, the server's answers are the frames.
-let kernel = null; // { regionId, method, data, out, synced }
+// ---- the frames of a drag in the page (drag_frames.js) -----------------------------------------
+// A drag is evaluated here, from the region's kernel fetched once after the region is ready; the
+// drag ends, and the pauses of the nonlinear method relax, on the server's positions. Until the
+// kernel (and a corrected kernel's first offsets) is here, the server's answers are the frames.
+let kernel = null; // a RegionKernel
 const engineLoaded = kernelInJs ? Promise.resolve('js') : loadEngine();
-/// The page's method choice of a region of the status.
-const methodOf = (region) => (region?.method === 'nonlinear' && region.energy === 'blended-motions' ? 'blended-motions' : region?.method);
 function loadKernel(s) {
-  releaseKernel(kernel?.data);
+  kernel?.release();
   kernel = null;
   if (!pageFrames || !s.region || !state.movable) return;
-  const regionId = s.region_id, movable = state.movable, method = methodOf(s.region);
-  Promise.all([fetch('api/region/kernel').then((r) => (r.ok ? bodyBytes(r) : null)), engineLoaded]).then(([buffer]) => {
-    if (!buffer || state.held.region !== regionId || state.movable !== movable) return;
-    const data = parseKernel(buffer, view.drawnNormals(movable));
-    releaseKernel(kernel?.data);
-    kernel = { regionId, method, data, out: new Float32Array(3 * movable.length), synced: !data.corrected };
-    state.marks.kernel.push({ at: performance.now(), bytes: buffer.byteLength });
+  const regionId = s.region_id, movable = state.movable;
+  RegionKernel.load(s, movable, view.drawnNormals(movable), engineLoaded).then((k) => {
+    if (!k || state.held.region !== regionId || state.movable !== movable) return k?.release();
+    kernel?.release();
+    kernel = k;
+    state.marks.kernel.push({ at: performance.now(), bytes: k.bytes });
     resyncKernel();
   }).catch((e) => console.warn(`region kernel: ${e.message}; the server's frames are shown`));
 }
@@ -154,19 +145,12 @@ function resyncKernel() {
   // A waiting move is not replaced: it asks for the offsets itself once the kernel is here.
   if (!frames.pending) frames.submit({ relax: true, offsets: true, kernel });
 }
-function kernelUsable() {
-  return !!kernel && kernel.synced && kernel.regionId === state.held.region && kernel.method === state.method &&
-         !!state.movable && kernel.out.length === 3 * state.movable.length &&
-         state.selected < kernel.data.handles;
-}
-/// Whether the server's answers should carry base offsets (a corrected kernel of this region and
-/// method).
-const kernelCorrected = () => !!kernel && kernel.data.corrected && kernel.regionId === state.held.region &&
-                              kernel.method === state.method;
+const kernelUsable = () => !!kernel && kernel.usable(state);
+const kernelCorrected = () => !!kernel && kernel.corrected(state);
 const transformRows = () => state.transforms.map(matrixToRows);
 /// The page's frame under the live transforms, shown.
 function showKernelFrame() {
-  evaluateKernel(kernel.data, transformRows(), kernel.out);
+  kernel.evaluate(transformRows());
   const evaluated = performance.now();
   view.applyMoved(state.movable, kernel.out, kernel.data.wasm?.drawn ?? null);
   return evaluated;
@@ -424,37 +408,13 @@ function matrixToRows(m) {
   return [e[0], e[4], e[8], e[12], e[1], e[5], e[9], e[13], e[2], e[6], e[10], e[14]];
 }
 
-// A frame: a handle's new map (POST transform), or for the nonlinear method more iterations under
-// the same maps while the pointer rests (POST relax). The answer is the movable vertices'
-// positions, none for a frame the page showed itself, and with a corrected kernel the base
-// offsets after them (request.offsets).
+// A frame: a handle's new map, or more iterations of the nonlinear method while the pointer rests.
 const RELAX_PAUSE_MS = 120, RELAX_BUDGET_MS = 40;
-function frameAnswer(request) {
-  if (request.local) return request.offsets ? 'base-offsets' : 'none';
-  return request.offsets ? 'positions-and-base-offsets' : 'positions';
-}
-async function sendFrame(request) {
-  request.sent = performance.now();
-  const answer = frameAnswer(request);
-  // A refused relax (the server busy with a new region) is dropped without a message.
-  const response = request.relax
-    ? await fetch('api/relax', { method: 'POST', headers: { 'Content-Type': 'application/json' },
-                                 body: JSON.stringify({ budget_ms: RELAX_BUDGET_MS, answer }) })
-    : await api('transform', { method: 'POST', headers: { 'Content-Type': 'application/json' },
-                               body: JSON.stringify({ handle: request.handle, matrix: request.matrix, answer }) });
-  if (!response.ok) throw new ApiError(response.status, 'relax refused');
-  const buffer = await bodyBytes(response), floats = new Float32Array(buffer);
-  const withOffsets = response.headers.has('X-Base-Offset-Rows');
-  const rows = withOffsets ? Number(response.headers.get('X-Base-Offset-Rows')) : 0, split = floats.length - 3 * rows;
-  return { moved: floats.subarray(0, split), offsets: withOffsets ? floats.subarray(split) : null, bytes: buffer.byteLength,
-           ms: parseFloat(response.headers.get('X-Frame-Ms')), converged: response.headers.get('X-Converged') !== '0' };
-}
 let lastMove = 0, relaxTimer = null;
 /// A corrected kernel takes the answer's base offsets (those of the kernel the request was sent
 /// with); after the drag's last move the page's frame is shown again with them.
 function receiveOffsets(result, request) {
-  if (!result.offsets || request.kernel !== kernel || !kernelCorrected() || !setRowOffsets(kernel.data, result.offsets)) return;
-  kernel.synced = true;
+  if (!result.offsets || request.kernel !== kernel || !kernelCorrected() || !kernel.takeOffsets(result.offsets)) return;
   if (!request.local || !kernelUsable()) return;
   const received = performance.now();
   if (!frames.pending) showKernelFrame();
@@ -464,7 +424,7 @@ function receiveOffsets(result, request) {
   state.converged = result.converged;
   if (!result.converged) relaxSoon();
 }
-const frames = new Coalescer(sendFrame, (result, request) => {
+const frames = new Coalescer((request) => sendFrame(request, RELAX_BUDGET_MS), (result, request) => {
   receiveOffsets(result, request);
   if (request.local) return; // shown by localFrame(), which also timed it
   if (!state.movable || result.moved.length !== 3 * state.movable.length) return;
@@ -651,7 +611,7 @@ window.remora = {
   /// The page's own frame (kernel.js) under `transforms` (per handle the 12 numbers of [M | t]),
   /// x, y, z per movable vertex; null before the region's kernel is here. how: the engine, 'wasm'
   /// (when the page has it) or 'js'.
-  kernelFrame: (transforms, how = 'wasm') => (kernelUsable() ? Array.from(evaluateKernel(kernel.data, transforms, new Float32Array(kernel.out.length), how)) : null),
+  kernelFrame: (transforms, how = 'wasm') => (kernelUsable() ? Array.from(kernel.evaluate(transforms, new Float32Array(kernel.out.length), how)) : null),
   /// The engine of the page's frames: 'wasm' (kernel.wasm) or 'js'.
   kernelEngine: () => (kernelUsable() && kernel.data.wasm ? 'wasm' : engine()),
   /// Median milliseconds of the page's frame under `transforms` per engine ('wasm', 'wasm1': one
@@ -662,7 +622,7 @@ window.remora = {
     for (let i = 0; i < n; ++i)
       for (const e of engines) {
         const t0 = performance.now();
-        evaluateKernel(kernel.data, transforms, out, e);
+        kernel.evaluate(transforms, out, e);
         times[e].push(performance.now() - t0);
       }
     return Object.fromEntries(engines.map((e) => [e, times[e].sort((a, b) => a - b)[n >> 1]]));
