@@ -46,7 +46,8 @@ const state = {
   labels: null, positions: null, indices: null, // labels: FIXED, FREE or a handle index per vertex
   movable: null, sentMovable: null, serverHandles: 0, transforms: [], dirtyRegion: false, status: null, frameMs: undefined,
   held: { mesh: undefined, positions: undefined, region: undefined }, // the status ids of what the page holds
-  marks: { paintMove: [], paintTrip: [], drag: [], dragBytes: [], dragServer: [], dragTrip: [], dragApply: [], dragKernel: [], kernel: [], regionReady: [], regionSteps: [], strokeEnd: null, paintable: null },
+  marks: { paintMove: [], paintTrip: [], drag: [], dragBytes: [], dragServer: [], dragTrip: [], dragApply: [], dragKernel: [], kernel: [], regionReady: [], regionSteps: [], strokeEnd: null, paintable: null,
+           relaxed: [], dragEnd: null },
 };
 const busy = () => state.status?.state === 'busy';
 
@@ -409,8 +410,10 @@ function matrixToRows(m) {
 }
 
 // A frame: a handle's new map, or more iterations of the nonlinear method while the pointer rests.
-const RELAX_PAUSE_MS = 120, RELAX_BUDGET_MS = 40;
-let lastMove = 0, relaxTimer = null;
+// A pause's relax steps double their budget from RELAX_BUDGET_MS to RELAX_BUDGET_MAX_MS: the
+// first answers soon, the later ones spend less of the pause on requests.
+const RELAX_PAUSE_MS = 120, RELAX_BUDGET_MS = 40, RELAX_BUDGET_MAX_MS = 320;
+let lastMove = 0, relaxTimer = null, relaxSteps = 0;
 /// A corrected kernel takes the answer's base offsets (those of the kernel the request was sent
 /// with); after the drag's last move the page's frame is shown again with them.
 function receiveOffsets(result, request) {
@@ -424,7 +427,7 @@ function receiveOffsets(result, request) {
   state.converged = result.converged;
   if (!result.converged) relaxSoon();
 }
-const frames = new Coalescer((request) => sendFrame(request, RELAX_BUDGET_MS), (result, request) => {
+const frames = new Coalescer((request) => sendFrame(request, request.budget ?? RELAX_BUDGET_MS), (result, request) => {
   receiveOffsets(result, request);
   if (request.local) return; // shown by localFrame(), which also timed it
   if (!state.movable || result.moved.length !== 3 * state.movable.length) return;
@@ -442,6 +445,10 @@ const frames = new Coalescer((request) => sendFrame(request, RELAX_BUDGET_MS), (
     state.marks.dragApply.push(done - received);
   }
   state.converged = result.converged;
+  if (result.converged && state.marks.dragEnd !== null && (request.relax || request.last)) { // release to converged
+    state.marks.relaxed.push(performance.now() - state.marks.dragEnd);
+    state.marks.dragEnd = null;
+  }
   if (!result.converged) relaxSoon();
   else if (request.relax) task(refreshStatus);
 });
@@ -452,8 +459,11 @@ function relaxSoon() {
   const wait = Math.max(0, lastMove + RELAX_PAUSE_MS - performance.now());
   relaxTimer = setTimeout(() => {
     relaxTimer = null;
-    if (!frames.pending && performance.now() - lastMove >= RELAX_PAUSE_MS) frames.submit({ relax: true, offsets: kernelCorrected(), kernel });
-    else if (!frames.pending) relaxSoon();
+    const budget = Math.min(RELAX_BUDGET_MAX_MS, RELAX_BUDGET_MS * 2 ** relaxSteps);
+    if (!frames.pending && performance.now() - lastMove >= RELAX_PAUSE_MS) {
+      frames.submit({ relax: true, budget, offsets: kernelCorrected(), kernel });
+      ++relaxSteps;
+    } else if (!frames.pending) relaxSoon();
   }, wait);
 }
 async function refreshStatus() {
@@ -465,6 +475,7 @@ let dragStart = null, dragBase = null, draggedLocally = false;
 gizmo.addEventListener('dragging-changed', (event) => {
   orbit.enabled = !event.value;
   if (event.value) {
+    state.marks.dragEnd = null;
     pivot.updateMatrix();
     dragStart = pivot.matrix.clone().invert();
     dragBase = (state.transforms[state.selected] || new THREE.Matrix4()).clone();
@@ -472,6 +483,8 @@ gizmo.addEventListener('dragging-changed', (event) => {
     return;
   }
   dragStart = null;
+  state.marks.dragEnd = performance.now();
+  lastMove = Math.min(lastMove, state.marks.dragEnd - RELAX_PAUSE_MS); // released: no pause to wait for
   const handle = state.selected, last = draggedLocally;
   task(async () => {
     // The page showed its own frames: the drag ends on the server's (the reference).
@@ -489,6 +502,7 @@ gizmo.addEventListener('objectChange', () => {
   const t = pivot.matrix.clone().multiply(dragStart).multiply(dragBase);
   state.transforms[state.selected] = t;
   lastMove = performance.now();
+  relaxSteps = 0;
   const local = localFrame(lastMove);
   draggedLocally ||= local;
   frames.submit({ handle: state.selected, matrix: matrixToRows(t), t0: lastMove, local, offsets: kernelCorrected(), kernel });

@@ -12,6 +12,8 @@
 //                        drag_cycle_shown_ms, drawn; of the hidden cycle: drag_server_ms, the server's
 //                        frame (X-Frame-Ms), drag_round_trip_ms, the request's send to its answer
 //                        read, drag_apply_ms, the positions and normals applied in the page;
+//   drag_to_converged_ms the manipulator's release to the converged shape shown: the last relax
+//                        step's answer applied (method nonlinear), or the drag's last answer;
 //   bake_ms              a new stroke after a move (the edited shape baked, a new region) until paintable;
 //                        The page evaluates the frames itself (web/kernel.js) once the region's
 //                        kernel is here: drag_kernel_ms is that evaluation (--server-frames: the
@@ -108,7 +110,7 @@ try {
 
   // Drags of the manipulator's arrow, the mesh shown, then hidden.
   const dragCycle = async () => {
-    const keys = ['drag', 'dragBytes', 'dragServer', 'dragTrip', 'dragApply', 'dragKernel'];
+    const keys = ['drag', 'dragBytes', 'dragServer', 'dragTrip', 'dragApply', 'dragKernel', 'relaxed'];
     const before = await marks();
     const pivot = await page.evaluate(() => window.remora.pivot());
     const c = await page.evaluate((p) => window.remora.projectPoint(...p), pivot);
@@ -116,8 +118,8 @@ try {
     await drag(page, c.x, c.y - 75, 0, -1, moves, frame);
     await ready(page);
     const mm = await marks();
-    const [ms, bytes, server, trip, apply, kernel] = keys.map((k) => mm[k].slice(before[k].length));
-    return { ms, bytes, server, trip, apply, kernel };
+    const [ms, bytes, server, trip, apply, kernel, relaxed] = keys.map((k) => mm[k].slice(before[k].length));
+    return { ms, bytes, server, trip, apply, kernel, relaxed };
   };
   // The page evaluates the drag's frames once the region's kernel is here (for the energies that
   // iterate, with the server's first base offsets).
@@ -149,7 +151,7 @@ try {
     mouseup_to_gizmo_beyond_set_region_ms: round(setRegion === null ? null : mouseupToGizmo - setRegion),
     drag_cycle_ms: round(median(hidden.ms)), drag_server_ms: round(median(hidden.server)),
     drag_round_trip_ms: round(median(hidden.trip)), drag_apply_ms: round(median(hidden.apply)),
-    drag_kernel_ms: round(median(hidden.kernel)),
+    drag_kernel_ms: round(median(hidden.kernel)), drag_to_converged_ms: round(median(hidden.relaxed)),
     kernel_after_mouseup_ms: round(kernelMark ? kernelMark.at - afterKernel.strokeEnd : null),
     kernel_bytes: kernelMark?.bytes ?? null,
     kernel_engine: await page.evaluate(() => window.remora.kernelEngine()),
