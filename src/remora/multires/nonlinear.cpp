@@ -410,7 +410,8 @@ Eigen::VectorXd NonlinearDeformer::Impl::anderson(const Eigen::VectorXd& g,
   last_f = f;
   const int m = std::min(history, depth);
   if (m == 0) return g;
-  const Eigen::MatrixXd dfm = df.leftCols(m), dgm = dg.leftCols(m);
+  const auto dfm = df.leftCols(m); // views: a copy of the history is 2·3·n·m doubles
+  const auto dgm = dg.leftCols(m);
   Eigen::MatrixXd normal = dfm.transpose() * dfm;
   normal.diagonal().array() += 1e-12 * normal.diagonal().maxCoeff() + 1e-300;
   const Eigen::VectorXd theta = normal.ldlt().solve(dfm.transpose() * f);
