@@ -596,10 +596,14 @@ void NonlinearDeformer::set_transforms(const std::vector<AffineMap>& transforms,
     Eigen::VectorXd g(static_cast<Eigen::Index>(3 * m.nf()));
     for (std::size_t r = 0; r < m.nf(); ++r)
       g.segment<3>(static_cast<Eigen::Index>(3 * r)) = guess->row(m.free_vertices[r]).transpose();
-    const Eigen::VectorXd predictor = m.free_vector() + (g - m.previous_guess);
+    const Eigen::VectorXd current = m.free_vector();
+    const Eigen::VectorXd predictor = current + (g - m.previous_guess);
+    // Positions still at the last guess (nothing iterated since) make the predictor the guess.
+    const bool same = current == m.previous_guess;
     m.current_energy = std::numeric_limits<double>::infinity();
     Eigen::VectorXd best = g;
     for (const Eigen::VectorXd* candidate : {&predictor, static_cast<const Eigen::VectorXd*>(&g)}) {
+      if (same && candidate == &predictor) continue;
       m.set_free(*candidate);
       const double e = m.local_step(rot);
       if (e < m.current_energy) {
