@@ -46,8 +46,7 @@ const state = {
   labels: null, positions: null, indices: null, // labels: FIXED, FREE or a handle index per vertex
   movable: null, sentMovable: null, serverHandles: 0, transforms: [], dirtyRegion: false, status: null, frameMs: undefined,
   held: { mesh: undefined, positions: undefined, region: undefined }, // the status ids of what the page holds
-  marks: { paintMove: [], paintTrip: [], drag: [], dragBytes: [], dragServer: [], dragTrip: [], dragApply: [], dragKernel: [], kernel: [], regionReady: [], regionSteps: [], strokeEnd: null, paintable: null,
-           relaxed: [], dragEnd: null },
+  marks: { paintMove: [], paintTrip: [], drag: [], dragBytes: [], dragServer: [], dragTrip: [], dragApply: [], dragKernel: [], kernel: [], regionReady: [], regionSteps: [], strokeEnd: null, paintable: null, relaxed: [], dragEnd: null },
 };
 const busy = () => state.status?.state === 'busy';
 
@@ -287,7 +286,7 @@ function regionLists() {
 /// while the server solves an older one replaces it (the server stops the older job); only the
 /// newest send brings the page up to the result. inStroke: sent in a pause of a stroke (no
 /// hints, the tool stays); keepGizmo: a new k under the same region.
-let regionSeq = 0;
+let regionSeq = 0, regionPosted = Promise.resolve();
 async function sendRegion({ keepGizmo = false, inStroke = false } = {}) {
   const started = performance.now(), seq = ++regionSeq;
   clearTimeout(relaxTimer);
@@ -306,8 +305,10 @@ async function sendRegion({ keepGizmo = false, inStroke = false } = {}) {
   }
   if (busy() && state.status?.progress?.job !== 'region') await settle(); // a load: wait for it
   const steps = { started, lists: performance.now() };
-  const posted = post('region', { support: compactIds(support), handles: handles.map(compactIds), k: state.k,
-                                  ...methodRequest(state.method) });
+  // After the last POST's answer: on another connection a newer region could arrive first.
+  const body = { support: compactIds(support), handles: handles.map(compactIds), k: state.k, ...methodRequest(state.method) };
+  const posted = regionPosted.then(() => post('region', body));
+  regionPosted = posted.catch(() => {});
   // The region's movable vertices are the support, handles included, sorted.
   state.sentMovable = support;
   steps.requested = performance.now();
@@ -410,8 +411,7 @@ function matrixToRows(m) {
 }
 
 // A frame: a handle's new map, or more iterations of the nonlinear method while the pointer rests.
-// A pause's relax steps double their budget from RELAX_BUDGET_MS to RELAX_BUDGET_MAX_MS: the
-// first answers soon, the later ones spend less of the pause on requests.
+// A pause's relax steps double their budget up to the maximum: fewer requests in a long pause.
 const RELAX_PAUSE_MS = 120, RELAX_BUDGET_MS = 40, RELAX_BUDGET_MAX_MS = 320;
 let lastMove = 0, relaxTimer = null, relaxSteps = 0;
 /// A corrected kernel takes the answer's base offsets (those of the kernel the request was sent

@@ -217,6 +217,21 @@ async function methodAfterMove(page, c, edit) {
         'the method linear again: the page shows its positions');
 }
 
+/// The unpainted vertex nearest `centre`: a stroke that starts there changes the region whatever
+/// earlier strokes painted.
+async function unpaintedNear(page, centre) {
+  return page.evaluate((c) => {
+    const p = window.remora.positionsHeld(), labels = window.remora.labels();
+    let best = -1, bestD = Infinity;
+    for (let v = 0; v < labels.length; ++v) {
+      if (labels[v] !== -2) continue;
+      const d = (p[3 * v] - c[0]) ** 2 + (p[3 * v + 1] - c[1]) ** 2 + (p[3 * v + 2] - c[2]) ** 2;
+      if (d < bestD) { bestD = d; best = v; }
+    }
+    return best;
+  }, centre);
+}
+
 /// While a job runs (a stroke after a move: the shape is baked into a new base) the progress shows
 /// "phase — NN %" and undo, redo and export are disabled. The bake may start in a pause of the
 /// stroke and end before mouse-up, so the page is watched from the stroke's start.
@@ -236,7 +251,7 @@ async function busyButtons(page, site) {
     window.__busyObserver = new MutationObserver(look);
     window.__busyObserver.observe(document.getElementById('panel'), { attributes: true, childList: true, subtree: true, characterData: true });
   });
-  await stroke(page, site.supportVertex);
+  await stroke(page, await unpaintedNear(page, site.support)); // a stroke that changes the region
   await ready(page, 180000);
   const seen = await page.evaluate(() => { window.__busyObserver.disconnect(); return window.__busySeen; });
   const during = seen.find((x) => /\d+ %/.test(x.text)) ?? { text: null, disabled: [] };
@@ -317,19 +332,7 @@ async function regionSentInPause(page, log, from) {
 async function regionInPause(page, log, c, site) {
   await page.keyboard.press('s');
   await remora(page, 'setRadius', 0.8 * site.supportRadius);
-  // Start on the unpainted vertex nearest the support's centre, so that the stroke changes the
-  // region whatever earlier strokes painted.
-  const startVertex = await page.evaluate((c) => {
-    const p = window.remora.positionsHeld(), labels = window.remora.labels();
-    let best = -1, bestD = Infinity;
-    for (let v = 0; v < labels.length; ++v) {
-      if (labels[v] !== -2) continue;
-      const d = (p[3 * v] - c[0]) ** 2 + (p[3 * v + 1] - c[1]) ** 2 + (p[3 * v + 2] - c[2]) ** 2;
-      if (d < bestD) { bestD = d; best = v; }
-    }
-    return best;
-  }, site.support);
-  const start = await remora(page, 'project', startVertex);
+  const start = await remora(page, 'project', await unpaintedNear(page, site.support));
   // A stroke with a pause in the middle, then more paint elsewhere.
   let from = log.length;
   await page.mouse.move(start.x, start.y);
