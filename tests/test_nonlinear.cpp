@@ -357,17 +357,28 @@ TEST(RotationBlend, IsTheSlerpForOneHandleAndExactForAPartitionOfUnity) {
   EXPECT_LT((blend_rotations({one[0], one[0]}, weights) - r).norm(), 1e-12);
 }
 
+// A cylinder of 17 rings of 24 (height 2) for the deformer alone: the bottom ring fixed, the
+// top ring handle 0, the handle's weight growing linearly with the height.
+struct DeformerCylinder {
+  Mesh m = make_cylinder(16, 24, 1.0, 2.0);
+  Eigen::MatrixXd rest = positions_matrix(m);
+  std::vector<int> labels = std::vector<int>(m.n_vertices(), Region::kFree);
+  Eigen::MatrixXd weights = rest.col(2) / 2.0;
+  DeformerCylinder() {
+    for (int s = 0; s < 24; ++s) {
+      labels[static_cast<std::size_t>(s)] = Region::kFixed;
+      labels[static_cast<std::size_t>(16 * 24 + s)] = 0;
+    }
+  }
+};
+
 // The deformer alone: the same minimizer from two different starts.
 TEST(NonlinearDeformer, ConvergesToTheSameShapeFromDifferentStarts) {
-  const Mesh m = make_cylinder(16, 24, 1.0, 2.0);
-  const Eigen::MatrixXd rest = positions_matrix(m);
-  std::vector<int> labels(m.n_vertices(), Region::kFree);
-  Eigen::MatrixXd weights = Eigen::MatrixXd::Zero(rest.rows(), 1);
-  for (int s = 0; s < 24; ++s) {
-    labels[static_cast<std::size_t>(s)] = Region::kFixed;
-    labels[static_cast<std::size_t>(16 * 24 + s)] = 0;
-  }
-  for (Eigen::Index v = 0; v < rest.rows(); ++v) weights(v, 0) = rest(v, 2) / 2.0;
+  const DeformerCylinder c;
+  const Mesh& m = c.m;
+  const Eigen::MatrixXd& rest = c.rest;
+  const std::vector<int>& labels = c.labels;
+  const Eigen::MatrixXd& weights = c.weights;
   NonlinearOptions o;
   o.tolerance = 1e-9;
   o.energy_tolerance = 0.0;
@@ -389,6 +400,24 @@ TEST(NonlinearDeformer, ConvergesToTheSameShapeFromDifferentStarts) {
     results[start] = d.positions();
   }
   EXPECT_LT((results[0] - results[1]).rowwise().norm().maxCoeff(), 1e-6);
+}
+
+// An interrupt (a server with another request waiting) ends a solve after the iteration under
+// way, whatever the budget; the next solve goes on from there to the same convergence.
+TEST(NonlinearDeformer, AnInterruptEndsTheSolveAfterTheIterationUnderWay) {
+  const DeformerCylinder c;
+  NonlinearDeformer d(c.m, c.rest, c.labels, c.weights);
+  d.set_transforms({rotation({0, 0, 1}, 1.2, {0, 0, 2})});
+  int asked = 0;
+  const NonlinearStats& first = d.solve(1e300, [&] { return ++asked > 0; });
+  EXPECT_EQ(first.iterations, 1);
+  EXPECT_EQ(asked, 1);
+  EXPECT_FALSE(first.finished());
+  asked = 0;
+  const NonlinearStats& rest_of_it = d.solve(1e300, [&] { return ++asked < 0; });
+  EXPECT_TRUE(rest_of_it.converged);
+  EXPECT_EQ(rest_of_it.total_iterations, rest_of_it.iterations + 1);
+  EXPECT_EQ(asked, rest_of_it.iterations - 1); // asked before each further iteration
 }
 
 // The local step's rotation against the SVD's (the optimum of tr(R P)), from the identity, on

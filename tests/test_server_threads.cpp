@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cmath>
 #include <condition_variable>
 #include <memory>
 #include <mutex>
@@ -241,6 +242,43 @@ TEST(ServerThreads, ConcurrentDragsEndOnOneOfTheirTransforms) {
   const auto shown = as<float>(call(s, "GET", "/api/mesh/positions"));
   ASSERT_EQ(move(s, *last).status, 200);
   EXPECT_EQ(as<float>(call(s, "GET", "/api/mesh/positions")), shown);
+}
+
+// A relax step with a long budget gives way to a request that waits for the session: it ends
+// after the iteration under way (another client polls the status all along), and the next step
+// goes on to convergence.
+TEST(ServerThreads, ARelaxStepGivesWayToARequestThatWaits) {
+  Session s;
+  const SphereRegion r = load_sphere_with_region(s);
+  ASSERT_EQ(
+      call(s, "POST", "/api/region",
+           json{{"support", r.support}, {"handles", {r.handle}}, {"method", "nonlinear"}}.dump())
+          .status,
+      202);
+  s.wait();
+  const double c = std::cos(1.5), n = std::sin(1.5);
+  ASSERT_EQ(call(s, "POST", "/api/transform",
+                 json{{"handle", 0},
+                      {"matrix", {c, -n, 0, 0, n, c, 0, 0, 0, 0, 1, 0.3}},
+                      {"answer", "none"}}
+                     .dump())
+                .status,
+            204);
+  std::atomic<bool> done{false};
+  HttpResponse first;
+  std::thread relax([&] {
+    first = call(s, "POST", "/api/relax", R"({"budget_ms": 10000})");
+    done = true;
+  });
+  while (!done) EXPECT_EQ(call(s, "GET", "/api/status").status, 200);
+  relax.join();
+  ASSERT_EQ(first.status, 200) << first.body;
+  const HttpResponse rest = call(s, "POST", "/api/relax", R"({"budget_ms": 10000})");
+  ASSERT_EQ(rest.status, 200) << rest.body;
+  EXPECT_EQ(first.headers.at("X-Converged"), "0");
+  EXPECT_EQ(rest.headers.at("X-Converged"), "1");
+  EXPECT_GT(std::stoi(rest.headers.at("X-Iterations")),
+            std::stoi(first.headers.at("X-Iterations")));
 }
 
 /// Connects to the loopback port, sends `bytes`, reads at most `keep` bytes of the answer and

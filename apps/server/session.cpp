@@ -1,6 +1,7 @@
 #include "session.h"
 
 #include <algorithm>
+#include <atomic>
 #include <functional>
 #include <stop_token>
 #include <string_view>
@@ -70,8 +71,7 @@ bool is_identity(const std::vector<Transform>& transforms) {
 }
 
 /// Where a phase of the editor's preprocessing sits in the whole of it, as [begin, end)
-/// fractions: a rough split (igea_sub4 spends about a quarter in the base surface and the rest in
-/// the remesh); the bar moves forward, it does not promise a time.
+/// fractions: a rough split; the bar moves forward, it does not promise a time.
 std::pair<double, double> preprocess_share(std::string_view phase) {
   if (phase == "reading") return {0.0, 0.05};
   if (phase == "bake") return {0.0, 1.0}; // a local bake; a full one reports the phases below
@@ -82,8 +82,7 @@ std::pair<double, double> preprocess_share(std::string_view phase) {
   return {0.97, 1.0};
 }
 
-/// The steps of the last set_region (docs/editing.md), in milliseconds; none when it took a
-/// region kept for an undo (no step ran).
+/// The steps of the last set_region (docs/editing.md) in ms; none for a region kept for an undo.
 nlohmann::json set_region_parts(const EditReport& r) {
   nlohmann::json parts = nlohmann::json::object();
   if (r.region_reused) return parts;
@@ -98,15 +97,21 @@ nlohmann::json set_region_parts(const EditReport& r) {
 struct Session::Impl {
   SessionOptions options;
   mutable std::mutex mutex;
+  mutable std::atomic<int> waiting{0}; // callers blocked on `mutex`: a relax step gives way
+  std::unique_lock<std::mutex> acquire() const {
+    ++waiting;
+    std::unique_lock lock(mutex);
+    --waiting;
+    return lock;
+  }
   std::condition_variable idle;
   std::thread worker;
   bool busy = false;
-  // The running job's stop request, and the job queued behind it: a new region while a region
-  // job runs stops that job (set_region checks between its steps) and runs next.
+  // The running job's stop request, and the job queued behind it (a new region stops a region
+  // job, which set_region checks between its steps).
   std::stop_source stop;
   std::function<void(std::stop_token)> pending;
-  // A bake kept for the next region job when a newer region stopped the job after its bake: the
-  // same editor under the same transforms bakes into the same shape.
+  // A bake kept for the next region job when a newer region stopped the job after its bake.
   std::shared_ptr<EditorBox> baked, baked_from;
   std::vector<Transform> baked_transforms;
   std::string job;   // what the worker does ("load", "region")
@@ -194,9 +199,8 @@ struct Session::Impl {
     const double within = n > 0 ? std::clamp(double(s) / n, 0.0, 1.0) : 0.0;
     fraction = span_begin + (span_end - span_begin) * (begin + (end - begin) * within);
   }
-  /// Runs `work` on the worker. While a region job runs, another region job stops it and is
-  /// queued behind it (replacing one queued already); any other overlap throws Busy. Call under
-  /// the lock.
+  /// Runs `work` on the worker. A region job while one runs stops it and is queued behind it
+  /// (replacing one queued already); any other overlap throws Busy. Call under the lock.
   void run(std::string what, std::function<void(std::stop_token)> work) {
     if (busy) {
       if (what == "region" && job == "region") {
@@ -217,10 +221,10 @@ struct Session::Impl {
         } catch (const Cancelled&) {
           // A newer region stopped it: that one runs next.
         } catch (const std::exception& e) {
-          std::lock_guard lock(mutex);
+          auto lock = acquire();
           error = e.what();
         }
-        std::lock_guard lock(mutex);
+        auto lock = acquire();
         if (pending) {
           work = std::move(pending);
           pending = nullptr;
@@ -248,7 +252,7 @@ struct Session::Impl {
   std::shared_ptr<EditorBox> bake_once(const std::shared_ptr<EditorBox>& current,
                                        const std::vector<Transform>& moved_by) {
     {
-      std::lock_guard lock(mutex);
+      auto lock = acquire();
       if (baked && baked_from == current && baked_transforms == moved_by) return baked;
     }
     // The edited shape becomes the next input: filtered and remeshed again where the edit
@@ -258,25 +262,24 @@ struct Session::Impl {
     auto next = std::make_shared<EditorBox>(std::move(result.editor));
     next->preprocess_ms = ms_since(t0);
     next->bake = std::move(result.report);
-    std::lock_guard lock(mutex);
+    auto lock = acquire();
     baked = next;
     baked_from = current;
     baked_transforms = moved_by;
     return next;
   }
-  /// A region job: the bake when a handle moved, the region prepared, then installed unless a
-  /// newer region stopped the job (that one runs next and installs its own): a stopped job
-  /// changes nothing.
   /// What a region job does: bake first (a handle moved and the paint changed), solve the same
   /// paint again under the same transforms (k or the method changed), set a new region (the
   /// paint or k changed).
   struct RegionWork {
     bool bake, resolve, new_region;
   };
+  /// A region job: the bake, the region prepared, then installed unless a newer region stopped
+  /// the job (that one runs next and installs its own): a stopped job changes nothing.
   void region_job(const RegionKey& key, RegionWork work, const std::shared_ptr<EditorBox>& current,
                   const std::vector<Transform>& moved_by, const std::stop_token& token) {
     {
-      std::lock_guard lock(mutex);
+      auto lock = acquire();
       span_begin = 0.0;
       span_end = work.bake ? 0.85 : 0.0;
     }
@@ -304,7 +307,7 @@ struct Session::Impl {
       restore();
       throw;
     }
-    std::lock_guard lock(mutex);
+    auto lock = acquire();
     if (token.stop_requested()) { // stale: the newer region is queued
       restore();
       return;
@@ -334,11 +337,12 @@ struct Session::Impl {
     push_snapshot();
   }
   /// positions(budget) of the editor, as the answer to a move or a relax step. Under the lock.
-  Frame frame(double budget_ms, FrameAnswer answer = FrameAnswer::Positions) {
+  Frame frame(double budget_ms, FrameAnswer answer = FrameAnswer::Positions,
+              const std::function<bool()>& interrupt = {}) {
     Editor& editor = box->editor;
     const auto t0 = Clock::now();
     Frame f;
-    const Eigen::MatrixXd& p = editor.positions(budget_ms);
+    const Eigen::MatrixXd& p = editor.positions(budget_ms, interrupt);
     if (answer == FrameAnswer::Positions || answer == FrameAnswer::PositionsAndBaseOffsets)
       f.positions = movable_floats(editor, p);
     if (answer == FrameAnswer::BaseOffsets || answer == FrameAnswer::PositionsAndBaseOffsets)
@@ -353,7 +357,7 @@ struct Session::Impl {
   /// report() under the lock, then the options' own progress callback without it. On the worker.
   void progress(std::string_view p, int s, int n) {
     {
-      std::lock_guard lock(mutex);
+      auto lock = acquire();
       report(p, s, n);
     }
     if (options.editor.progress) options.editor.progress(p, s, n);
@@ -375,22 +379,22 @@ Session::~Session() {
 }
 
 void Session::wait() {
-  std::unique_lock lock(impl_->mutex);
+  auto lock = impl_->acquire();
   impl_->idle.wait(lock, [&] { return !impl_->busy; });
 }
 
 std::size_t Session::vertex_count() const {
-  std::lock_guard lock(impl_->mutex);
+  auto lock = impl_->acquire();
   return impl_->box ? impl_->box->editor.input().n_vertices() : 0;
 }
 
 void Session::wait_for(std::chrono::milliseconds timeout) {
-  std::unique_lock lock(impl_->mutex);
+  auto lock = impl_->acquire();
   impl_->idle.wait_for(lock, timeout, [&] { return !impl_->busy; });
 }
 
 void Session::start_load(std::string bytes, std::string name) {
-  std::lock_guard lock(impl_->mutex);
+  auto lock = impl_->acquire();
   const MeshFormat format = format_from_path(name); // IoError for an unknown extension at once
   impl_->run("load", [this, bytes = std::move(bytes), name, format](std::stop_token) {
     Impl& m = *impl_;
@@ -427,7 +431,7 @@ void Session::start_load(std::string bytes, std::string name) {
 
 void Session::start_region(std::vector<int> support, std::vector<std::vector<int>> handles, int k,
                            EditMethod method, std::optional<NonlinearEnergy> energy) {
-  std::lock_guard lock(impl_->mutex);
+  auto lock = impl_->acquire();
   Impl& m = *impl_;
   if (!(m.busy && m.job == "region")) m.require_ready(); // a region job: stopped and followed
   if (k < 1 || k > 3) throw InvalidArgument(fmt::format("k = {} is not 1, 2 or 3", k));
@@ -471,7 +475,7 @@ void Session::start_region(std::vector<int> support, std::vector<std::vector<int
 }
 
 Frame Session::set_transform(int handle, const Transform& transform, FrameAnswer answer) {
-  std::lock_guard lock(impl_->mutex);
+  auto lock = impl_->acquire();
   Impl& m = *impl_;
   m.require_region();
   m.require_offsets(answer);
@@ -483,18 +487,18 @@ Frame Session::set_transform(int handle, const Transform& transform, FrameAnswer
 }
 
 Frame Session::relax(double budget_ms, FrameAnswer answer) {
-  std::lock_guard lock(impl_->mutex);
+  auto lock = impl_->acquire();
   Impl& m = *impl_;
   m.require_region();
   m.require_offsets(answer);
   if (!(budget_ms > 0.0) || !(budget_ms <= 10000.0))
     throw InvalidArgument("budget_ms: expected milliseconds above 0, at most 10000");
   if (answer == FrameAnswer::None) throw InvalidArgument("a relax step answers something");
-  return m.frame(budget_ms, answer);
+  return m.frame(budget_ms, answer, [&m] { return m.waiting > 0; }); // another request first
 }
 
 void Session::commit() {
-  std::lock_guard lock(impl_->mutex);
+  auto lock = impl_->acquire();
   Impl& m = *impl_;
   m.require_region();
   const Snapshot& s = m.history[m.cursor];
@@ -503,7 +507,7 @@ void Session::commit() {
 }
 
 bool Session::undo() {
-  std::lock_guard lock(impl_->mutex);
+  auto lock = impl_->acquire();
   Impl& m = *impl_;
   m.require_ready();
   if (m.cursor == 0) return false;
@@ -512,7 +516,7 @@ bool Session::undo() {
 }
 
 bool Session::redo() {
-  std::lock_guard lock(impl_->mutex);
+  auto lock = impl_->acquire();
   Impl& m = *impl_;
   m.require_ready();
   if (m.cursor + 1 >= m.history.size()) return false;
@@ -521,7 +525,7 @@ bool Session::redo() {
 }
 
 nlohmann::json Session::status() const {
-  std::lock_guard lock(impl_->mutex);
+  auto lock = impl_->acquire();
   const Impl& m = *impl_;
   nlohmann::json j;
   j["state"] = m.busy ? "busy" : (m.box ? "ready" : "empty");
@@ -582,7 +586,7 @@ nlohmann::json Session::status() const {
 }
 
 nlohmann::json Session::region() const {
-  std::lock_guard lock(impl_->mutex);
+  auto lock = impl_->acquire();
   const Impl& m = *impl_;
   m.require_ready();
   if (!m.region) return nullptr;
@@ -606,7 +610,7 @@ std::vector<float> to_floats(const Eigen::MatrixXd& p) {
 } // namespace
 
 std::vector<float> Session::positions() const {
-  std::lock_guard lock(impl_->mutex);
+  auto lock = impl_->acquire();
   const Impl& m = *impl_;
   m.require_ready();
   Editor& editor = m.box->editor;
@@ -625,27 +629,27 @@ std::vector<std::uint32_t> face_indices(const Mesh& mesh) {
 } // namespace
 
 std::vector<std::uint32_t> Session::indices() const {
-  std::lock_guard lock(impl_->mutex);
+  auto lock = impl_->acquire();
   impl_->require_ready();
   return face_indices(impl_->box->editor.input());
 }
 
 std::vector<std::uint32_t> Session::movable_vertices() const {
-  std::lock_guard lock(impl_->mutex);
+  auto lock = impl_->acquire();
   impl_->require_ready();
   const auto& movable = impl_->box->editor.movable_vertices();
   return {movable.begin(), movable.end()};
 }
 
 FrameExport Session::frame_export() const {
-  std::lock_guard lock(impl_->mutex);
+  auto lock = impl_->acquire();
   const Impl& m = *impl_;
   m.require_region();
   return remora::frame_export(m.box->editor);
 }
 
 std::vector<float> Session::base_positions() const {
-  std::lock_guard lock(impl_->mutex);
+  auto lock = impl_->acquire();
   const Impl& m = *impl_;
   m.require_ready();
   Editor& editor = m.box->editor;
@@ -653,13 +657,13 @@ std::vector<float> Session::base_positions() const {
 }
 
 std::vector<std::uint32_t> Session::base_indices() const {
-  std::lock_guard lock(impl_->mutex);
+  auto lock = impl_->acquire();
   impl_->require_ready();
   return face_indices(impl_->box->editor.base());
 }
 
 std::vector<float> Session::base_areas() const {
-  std::lock_guard lock(impl_->mutex);
+  auto lock = impl_->acquire();
   impl_->require_ready();
   const Eigen::VectorXd a = vertex_areas_mixed(impl_->box->editor.base());
   const double mean = a.size() > 0 ? a.mean() : 1.0;
@@ -671,7 +675,7 @@ std::vector<float> Session::base_areas() const {
 
 Pick Session::pick(const Vec3& origin, const Vec3& direction, double radius, Brush brush,
                    std::int64_t stroke) {
-  std::lock_guard lock(impl_->mutex);
+  auto lock = impl_->acquire();
   if (!impl_->shape) throw Busy("no mesh is loaded yet: load one first");
   Impl& m = *impl_;
   // Not while a job holds the editor: its install brings the shape up to date.
@@ -680,7 +684,7 @@ Pick Session::pick(const Vec3& origin, const Vec3& direction, double radius, Bru
 }
 
 std::string Session::name() const {
-  std::lock_guard lock(impl_->mutex);
+  auto lock = impl_->acquire();
   return impl_->name;
 }
 
@@ -689,7 +693,7 @@ std::string Session::export_mesh(const std::string& format) const {
     throw InvalidArgument(fmt::format("unknown export format '{}': use obj, ply or stl", format));
   Mesh result;
   {
-    std::lock_guard lock(impl_->mutex);
+    auto lock = impl_->acquire();
     impl_->require_ready();
     result = impl_->region ? impl_->box->editor.result() : impl_->box->editor.input();
   }

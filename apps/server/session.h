@@ -111,8 +111,9 @@ public:
   Frame set_transform(int handle, const Transform& transform,
                       FrameAnswer answer = FrameAnswer::Positions);
   /// Method nonlinear: iterates for at most `budget_ms` more under the live transforms (the
-  /// page calls it while the user pauses, until converged). Method linear: the frame as it is,
-  /// converged. Answers as set_transform() does, but never nothing.
+  /// page calls it while the user pauses, until converged), ending after the iteration under
+  /// way when another call waits for the session. Method linear: the frame as it is, converged.
+  /// Answers as set_transform() does, but never nothing.
   Frame relax(double budget_ms, FrameAnswer answer = FrameAnswer::Positions);
   /// Records the live transforms as a snapshot (the end of a drag). No-op when nothing changed.
   void commit();

@@ -287,14 +287,15 @@ const Transform& Editor::transform(int handle) const {
 
 // Method nonlinear, in a frame: r.current_base holds the blend (the linear result); the region's
 // nonlinear state replaces its free rows, or leaves the blend with a message.
-void Editor::Impl::deform_base(RegionState& r, bool moved, double budget_ms) {
+void Editor::Impl::deform_base(RegionState& r, bool moved, double budget_ms,
+                               const std::function<bool()>& interrupt) {
   if (!r.nonlinear || r.nonlinear_energy != options.nonlinear.energy) { // after set_method()
     build_nonlinear(r, report);
     if (r.coarse) coarse = r.coarse;
   }
   const auto t0 = Clock::now();
   RowPoints positions = r.frame.leftCols<3>();
-  r.nonlinear->frame(r.transforms, moved, budget_ms, positions);
+  r.nonlinear->frame(r.transforms, moved, budget_ms, positions, interrupt);
   r.frame.leftCols<3>() = positions;
   report.method = "nonlinear";
   report.nonlinear_energy = to_string(options.nonlinear.energy);
@@ -304,7 +305,7 @@ void Editor::Impl::deform_base(RegionState& r, bool moved, double budget_ms) {
   report.milliseconds["frame nonlinear"] = ms_since(t0);
 }
 
-void Editor::Impl::update(double budget_ms) {
+void Editor::Impl::update(double budget_ms, const std::function<bool()>& interrupt) {
   RegionState& r = state();
   const bool iterating =
       options.method == EditMethod::Nonlinear && r.nonlinear && !r.nonlinear->finished();
@@ -325,7 +326,7 @@ void Editor::Impl::update(double budget_ms) {
   }
   report.milliseconds["frame blend"] = ms_since(t0);
   report.method = to_string(options.method);
-  if (options.method == EditMethod::Nonlinear) deform_base(r, r.dirty, budget_ms);
+  if (options.method == EditMethod::Nonlinear) deform_base(r, r.dirty, budget_ms, interrupt);
   const auto t_normals = Clock::now();
   // Normals where they can change.
   update_normals(r.affected, r.frame, r.face_normals, threads);
@@ -342,7 +343,11 @@ const Eigen::MatrixXd& Editor::positions() {
 }
 
 const Eigen::MatrixXd& Editor::positions(double budget_ms) {
-  impl_->update(budget_ms);
+  return positions(budget_ms, {});
+}
+
+const Eigen::MatrixXd& Editor::positions(double budget_ms, const std::function<bool()>& interrupt) {
+  impl_->update(budget_ms, interrupt);
   return impl_->region->current_positions;
 }
 

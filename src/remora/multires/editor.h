@@ -315,6 +315,9 @@ public:
   /// one), continuing from the last call, then the decode; call again to go on towards
   /// convergence. The same as positions() for method linear.
   const Eigen::MatrixXd& positions(double budget_ms);
+  /// The same, and no iteration begins after the one under way once `interrupt` returns true
+  /// (a server with another request waiting). Called on this thread between iterations.
+  const Eigen::MatrixXd& positions(double budget_ms, const std::function<bool()>& interrupt);
   /// Whether positions() are final: true for method linear, and for nonlinear once the
   /// iteration has converged, reached its max_iterations or fallen back to the linear result.
   bool converged() const;

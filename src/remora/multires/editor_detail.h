@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <deque>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <stop_token>
@@ -85,9 +86,10 @@ struct Editor::Impl : EditorParts {
     if (!region) throw InvalidArgument("no region yet: call set_region() first");
     return *region;
   }
-  void update(double budget_ms);
+  void update(double budget_ms, const std::function<bool()>& interrupt = {});
   void build_nonlinear(RegionState& r, EditReport& into);
-  void deform_base(RegionState& r, bool moved, double budget_ms);
+  void deform_base(RegionState& r, bool moved, double budget_ms,
+                   const std::function<bool()>& interrupt);
 
   // The steps of set_region(), in order, on a new state (the current region stays until all
   // succeed).

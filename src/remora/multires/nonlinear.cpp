@@ -621,7 +621,8 @@ void NonlinearDeformer::set_transforms(const std::vector<AffineMap>& transforms,
   m.stats.converged = false;
 }
 
-const NonlinearStats& NonlinearDeformer::solve(double budget_ms) {
+const NonlinearStats& NonlinearDeformer::solve(double budget_ms,
+                                               const std::function<bool()>& interrupt) {
   Impl& m = *impl_;
   m.stats.iterations = 0;
   m.stats.accelerated = 0;
@@ -636,7 +637,8 @@ const NonlinearStats& NonlinearDeformer::solve(double budget_ms) {
     const auto t = Clock::now();
     m.iterate();
     slowest = std::max(slowest, ms_since(t));
-  } while (!m.stats.finished() && ms_since(t0) + slowest <= budget_ms);
+  } while (!m.stats.finished() && ms_since(t0) + slowest <= budget_ms &&
+           !(interrupt && interrupt()));
   return m.stats;
 }
 

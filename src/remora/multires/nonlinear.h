@@ -38,6 +38,7 @@
 // NumericalError when the global matrix cannot be factored.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -118,8 +119,10 @@ public:
   void set_transforms(const std::vector<AffineMap>& transforms, const RowPoints* guess = nullptr);
   /// Iterates until converged, max_iterations (counted since set_transforms()) or `budget_ms` of
   /// wall time: at least one iteration unless finished, and another only when it would end within
-  /// the budget, were it as slow as the slowest of this call. Returns the stats of this call.
-  const NonlinearStats& solve(double budget_ms = 1e300);
+  /// the budget, were it as slow as the slowest of this call, and `interrupt` (when given) returns
+  /// false (a caller with other work waiting). Returns the stats of this call.
+  const NonlinearStats& solve(double budget_ms = 1e300,
+                              const std::function<bool()>& interrupt = {});
   /// Every base vertex: the free rows as solved, the constrained ones at their values.
   const RowPoints& positions() const;
   const std::vector<int>& free_vertices() const;

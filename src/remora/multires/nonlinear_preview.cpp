@@ -99,8 +99,9 @@ void NonlinearPreview::set_transforms(const std::vector<AffineMap>& transforms,
   deformer_->set_transforms(transforms, &restricted_);
 }
 
-const NonlinearStats& NonlinearPreview::solve(double budget_ms) {
-  return deformer_->solve(budget_ms);
+const NonlinearStats& NonlinearPreview::solve(double budget_ms,
+                                              const std::function<bool()>& interrupt) {
+  return deformer_->solve(budget_ms, interrupt);
 }
 
 const NonlinearStats& NonlinearPreview::stats() const {

@@ -21,6 +21,7 @@
 #pragma once
 
 #include <array>
+#include <functional>
 #include <vector>
 
 #include <Eigen/Core>
@@ -42,7 +43,7 @@ public:
   /// New handle maps; `linear` (B's vertices, n × 3) is the fine linear result under them.
   void set_transforms(const std::vector<AffineMap>& transforms, const RowPoints& linear);
   /// Coarse iterations (NonlinearDeformer::solve).
-  const NonlinearStats& solve(double budget_ms);
+  const NonlinearStats& solve(double budget_ms, const std::function<bool()>& interrupt = {});
   const NonlinearStats& stats() const;
   /// out.row(v) = linear.row(v) + the interpolated correction, for every free vertex v of B.
   void compose(const RowPoints& linear, RowPoints& out) const;

@@ -61,7 +61,7 @@ bool NonlinearRegion::finished() const {
 }
 
 void NonlinearRegion::frame(const std::vector<AffineMap>& transforms, bool moved, double budget_ms,
-                            RowPoints& base) {
+                            RowPoints& base, const std::function<bool()>& interrupt) {
   if (!fine_) {
     fallback_ = setup_error_;
     return;
@@ -77,17 +77,17 @@ void NonlinearRegion::frame(const std::vector<AffineMap>& transforms, bool moved
       if (preview_) preview_->set_transforms(transforms, base);
     }
     if (preview_ && fine_stale_ && !preview_->stats().finished()) {
-      stats_ = preview_->solve(budget_ms);
+      stats_ = preview_->solve(budget_ms, interrupt);
       level_ = "coarse";
       preview_->compose(linear_, base);
-      if (!stats_.finished() || ms_since(t0) >= budget_ms) return;
+      if (!stats_.finished() || ms_since(t0) >= budget_ms || (interrupt && interrupt())) return;
     }
     if (fine_stale_) { // start from the preview's result, or from the linear one
       if (preview_) preview_->compose(linear_, base);
       fine_->set_transforms(transforms, &base);
       fine_stale_ = false;
     }
-    stats_ = fine_->solve(std::max(0.0, budget_ms - ms_since(t0)));
+    stats_ = fine_->solve(std::max(0.0, budget_ms - ms_since(t0)), interrupt);
     level_ = "fine";
     const RowPoints& x = fine_->positions();
     for (const int v : free_)

@@ -10,6 +10,7 @@
 // the linear result instead, with the reason in fallback(); a new move tries again.
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -43,9 +44,10 @@ public:
   ~NonlinearRegion();
 
   /// One frame: `base` (every base vertex) holds the linear result under `transforms`; its free
-  /// rows are replaced. `moved`: the transforms changed since the last frame.
+  /// rows are replaced. `moved`: the transforms changed since the last frame. `interrupt`: as for
+  /// NonlinearDeformer::solve(), also between the levels.
   void frame(const std::vector<AffineMap>& transforms, bool moved, double budget_ms,
-             RowPoints& base);
+             RowPoints& base, const std::function<bool()>& interrupt = {});
   /// Nothing left to iterate under the current transforms (or fallen back).
   bool finished() const;
   /// The last frame's iterations, of the level it ran last.
