@@ -245,8 +245,10 @@ TEST(ServerThreads, ConcurrentDragsEndOnOneOfTheirTransforms) {
 }
 
 // A relax step with a long budget gives way to a request that waits for the session: it ends
-// after the iteration under way (another client polls the status all along), and the next step
-// goes on to convergence.
+// after the iteration under way, and the next step goes on to convergence. Three clients poll
+// the status while a step runs; a step can still end first (a small region converges in a few
+// milliseconds, and a loaded machine may not run the clients meanwhile), so the edit is tried
+// again, under new transforms, until one step has given way.
 TEST(ServerThreads, ARelaxStepGivesWayToARequestThatWaits) {
   Session s;
   const SphereRegion r = load_sphere_with_region(s);
@@ -256,29 +258,38 @@ TEST(ServerThreads, ARelaxStepGivesWayToARequestThatWaits) {
           .status,
       202);
   s.wait();
-  const double c = std::cos(1.5), n = std::sin(1.5);
-  ASSERT_EQ(call(s, "POST", "/api/transform",
-                 json{{"handle", 0},
-                      {"matrix", {c, -n, 0, 0, n, c, 0, 0, 0, 0, 1, 0.3}},
-                      {"answer", "none"}}
-                     .dump())
-                .status,
-            204);
-  std::atomic<bool> done{false};
-  HttpResponse first;
-  std::thread relax([&] {
-    first = call(s, "POST", "/api/relax", R"({"budget_ms": 10000})");
+  int gave_way = 0;
+  for (int attempt = 0; attempt < 40 && gave_way == 0; ++attempt) {
+    const double a = 1.0 + 0.01 * attempt, c = std::cos(a), n = std::sin(a);
+    ASSERT_EQ(call(s, "POST", "/api/transform",
+                   json{{"handle", 0},
+                        {"matrix", {c, -n, 0, 0, n, c, 0, 0, 0, 0, 1, 0.3}},
+                        {"answer", "none"}}
+                       .dump())
+                  .status,
+              204);
+    std::atomic<bool> done{false};
+    std::atomic<int> wrong{0}, polling{0};
+    std::vector<std::thread> pollers;
+    for (int t = 0; t < 3; ++t)
+      pollers.emplace_back([&] {
+        wrong += call(s, "GET", "/api/status").status != 200;
+        ++polling;
+        while (!done) wrong += call(s, "GET", "/api/status").status != 200;
+      });
+    while (polling < 3) std::this_thread::yield();
+    const HttpResponse first = call(s, "POST", "/api/relax", R"({"budget_ms": 10000})");
     done = true;
-  });
-  while (!done) EXPECT_EQ(call(s, "GET", "/api/status").status, 200);
-  relax.join();
-  ASSERT_EQ(first.status, 200) << first.body;
-  const HttpResponse rest = call(s, "POST", "/api/relax", R"({"budget_ms": 10000})");
-  ASSERT_EQ(rest.status, 200) << rest.body;
-  EXPECT_EQ(first.headers.at("X-Converged"), "0");
-  EXPECT_EQ(rest.headers.at("X-Converged"), "1");
-  EXPECT_GT(std::stoi(rest.headers.at("X-Iterations")),
-            std::stoi(first.headers.at("X-Iterations")));
+    for (auto& p : pollers) p.join();
+    EXPECT_EQ(wrong.load(), 0);
+    ASSERT_EQ(first.status, 200) << first.body;
+    if (first.headers.at("X-Converged") == "1") continue; // ended before a client waited
+    ++gave_way;
+    const HttpResponse rest = call(s, "POST", "/api/relax", R"({"budget_ms": 10000})");
+    ASSERT_EQ(rest.status, 200) << rest.body;
+    EXPECT_EQ(rest.headers.at("X-Converged"), "1");
+  }
+  EXPECT_EQ(gave_way, 1); // without the interrupt every step runs to convergence
 }
 
 /// Connects to the loopback port, sends `bytes`, reads at most `keep` bytes of the answer and
