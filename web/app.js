@@ -410,9 +410,8 @@ function matrixToRows(m) {
   return [e[0], e[4], e[8], e[12], e[1], e[5], e[9], e[13], e[2], e[6], e[10], e[14]];
 }
 
-// A frame: a handle's new map, or more iterations of the nonlinear method while the pointer rests.
-// A pause's relax steps double their budget up to the maximum: fewer requests in a long pause.
-const RELAX_PAUSE_MS = 120, RELAX_BUDGET_MS = 40, RELAX_BUDGET_MAX_MS = 320;
+// A frame: a handle's new map, or, while the pointer rests, more nonlinear iterations in steps
+const RELAX_PAUSE_MS = 120, RELAX_BUDGET_MS = 40, RELAX_BUDGET_MAX_MS = 320; // whose budget doubles
 let lastMove = 0, relaxTimer = null, relaxSteps = 0;
 /// A corrected kernel takes the answer's base offsets (those of the kernel the request was sent
 /// with); after the drag's last move the page's frame is shown again with them.

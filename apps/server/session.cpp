@@ -107,15 +107,13 @@ struct Session::Impl {
   std::condition_variable idle;
   std::thread worker;
   bool busy = false;
-  // The running job's stop request, and the job queued behind it (a new region stops a region
-  // job, which set_region checks between its steps).
+  // The running job's stop request, and the job queued behind it (a new region stops a region job).
   std::stop_source stop;
   std::function<void(std::stop_token)> pending;
   // A bake kept for the next region job when a newer region stopped the job after its bake.
   std::shared_ptr<EditorBox> baked, baked_from;
   std::vector<Transform> baked_transforms;
-  std::string job;   // what the worker does ("load", "region")
-  std::string phase; // its current phase
+  std::string job, phase; // what the worker does ("load", "region"), and its current phase
   int step = 0, steps = 0;
   double fraction = 0.0;                   // of the whole job
   double span_begin = 0.0, span_end = 1.0; // the share of the job preprocessing takes
@@ -268,14 +266,12 @@ struct Session::Impl {
     baked_transforms = moved_by;
     return next;
   }
-  /// What a region job does: bake first (a handle moved and the paint changed), solve the same
-  /// paint again under the same transforms (k or the method changed), set a new region (the
-  /// paint or k changed).
+  /// What a region job does: bake first (a handle moved and the paint changed), solve the paint
+  /// again under the same transforms (k or the method changed), set a new region (paint or k).
   struct RegionWork {
     bool bake, resolve, new_region;
   };
-  /// A region job: the bake, the region prepared, then installed unless a newer region stopped
-  /// the job (that one runs next and installs its own): a stopped job changes nothing.
+  /// A region job: the bake, the region prepared, then installed unless a newer region stopped it.
   void region_job(const RegionKey& key, RegionWork work, const std::shared_ptr<EditorBox>& current,
                   const std::vector<Transform>& moved_by, const std::stop_token& token) {
     {
