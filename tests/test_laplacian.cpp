@@ -200,6 +200,24 @@ TEST(LaplacianWeights, SymmetricWithZeroRowSums) {
   }
 }
 
+// The weight of one edge at other points than the mesh's own is the moved mesh's weight, bit for
+// bit (what the nonlinear method reads for its rest shape's cells without moving a copy).
+TEST(LaplacianWeights, OneEdgeAtOtherPointsIsTheMovedMeshsWeight) {
+  const Mesh mesh = make_icosphere(3);
+  Mesh moved = mesh;
+  jitter(moved, 0.3, 19);
+  Eigen::MatrixXd points(static_cast<Eigen::Index>(mesh.n_vertices()), 3);
+  for (const VertexHandle v : moved.vertices())
+    for (int c = 0; c < 3; ++c) points(v.idx(), c) = moved.point(v)[c];
+  const Eigen::SparseMatrix<double> W = cotan_weights(moved);
+  for (const EdgeHandle e : mesh.edges()) {
+    const HalfedgeHandle h = mesh.halfedge_handle(e, 0);
+    const int i = mesh.from_vertex_handle(h).idx(), j = mesh.to_vertex_handle(h).idx();
+    ASSERT_EQ(cotan_weight(mesh, points, e), W.coeff(i, j)) << "edge " << e.idx();
+    ASSERT_NE(cotan_weight(mesh, e), W.coeff(i, j)) << "edge " << e.idx(); // the points matter
+  }
+}
+
 TEST(LaplacianWeights, ZeroAreaFacesContributeNothing) {
   // a, m, b collinear (m the midpoint) with the flat face (a, b, m) under the two faces on c:
   // a manifold mesh with a zero-area face, and another zero-area face on two coincident points.

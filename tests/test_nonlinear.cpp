@@ -23,6 +23,8 @@
 #include "remora/mesh/primitives.h"
 #include "remora/multires/best_rotation.h"
 #include "remora/multires/editor.h"
+#include "remora/multires/nonlinear_region.h"
+#include "remora/multires/phong.h"
 #include "remora/multires/rotation_blend.h"
 
 namespace remora {
@@ -123,6 +125,45 @@ TEST(Nonlinear, TheCoarsePreviewIsCloseAndTheFineLevelTakesOver) {
   // Exact cases through the preview.
   editor.set_transform(0, identity_transform());
   EXPECT_LT(max_row_distance(editor.positions(1e-3), input), 1e-10 * c.height);
+}
+
+// The preview's coarse base is a remesh of the support's part of the base, with a margin: it
+// covers the free vertices, lies on the base, leaves the far side alone, and serves a region
+// painted again a little larger, not one elsewhere or of another size.
+TEST(Nonlinear, TheCoarseBaseIsARemeshOfTheSupportsPartOfTheBase) {
+  const Mesh sphere = make_icosphere(5); // 10,242 vertices, edge about 0.038
+  const TriangleTopology topology = triangle_topology(sphere);
+  const Eigen::MatrixXd points = positions_matrix(sphere);
+  const VertexHandle north = nearest_vertex(sphere, Vec3(0, 0, 1));
+  const VertexHandle south = nearest_vertex(sphere, Vec3(0, 0, -1));
+  NonlinearOptions o;
+  o.preview_vertices = 300;
+  const std::vector<int> cap = select_geodesic_disc(sphere, north, 0.8); // about 1,600
+  const RemeshResult coarse = make_coarse_base(sphere, topology, points, cap, o);
+  ASSERT_EQ(coarse.input_on_output.size(), sphere.n_vertices());
+  ASSERT_EQ(coarse.output_on_input.size(), coarse.mesh.n_vertices());
+  const double length = mean_edge_length(coarse.mesh);
+  EXPECT_NEAR(length / coarse_length(mean_edge_length(sphere), cap.size(), o), 1.0, 0.25);
+  EXPECT_LT(coarse.mesh.n_vertices(), cap.size()); // a part, coarser
+  for (const int v : cap) {
+    const SurfacePoint& sp = coarse.input_on_output[static_cast<std::size_t>(v)];
+    ASSERT_TRUE(sp.face.is_valid()) << v;
+    EXPECT_LT((evaluate(coarse.mesh, sp) - sphere.point(VertexHandle(v))).norm(), 0.1 * length);
+  }
+  EXPECT_FALSE(coarse.input_on_output[static_cast<std::size_t>(south.idx())].face.is_valid());
+  for (const VertexHandle c : coarse.mesh.vertices()) { // on the base's faces
+    const SurfacePoint& sp = coarse.output_on_input[static_cast<std::size_t>(c.idx())];
+    ASSERT_TRUE(sp.face.is_valid());
+    EXPECT_LT((evaluate(sphere, sp) - coarse.mesh.point(c)).norm(), 1e-9);
+  }
+  EXPECT_TRUE(coarse_base_serves(coarse, sphere, topology, cap, o));
+  EXPECT_TRUE(
+      coarse_base_serves(coarse, sphere, topology, select_geodesic_disc(sphere, north, 0.83), o));
+  EXPECT_FALSE(
+      coarse_base_serves(coarse, sphere, topology, select_geodesic_disc(sphere, south, 0.8), o));
+  NonlinearOptions coarser = o; // the same region previewed at a third of the vertices
+  coarser.preview_vertices = 100;
+  EXPECT_FALSE(coarse_base_serves(coarse, sphere, topology, cap, coarser));
 }
 
 TEST(Nonlinear, TheEnergyNeverIncreases) {

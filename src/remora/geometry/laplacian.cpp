@@ -17,21 +17,27 @@
 namespace remora {
 namespace {
 
+/// The mesh's own vertex positions, as half_cotangents() reads them.
+auto own_point(const Mesh& mesh) {
+  return [&mesh](VertexHandle v) { return mesh.point(v); };
+}
+
 // Doubled area over the longest squared edge (about the smallest angle in radians) at or below
 // which a face counts as zero-area: its cotangents would be rounding noise of size up to 1e16.
 constexpr double kZeroAreaFace = 1e-12;
 
 /// Half the cotangent of each corner of face f, with the edge opposite it: {weight, edge idx()}
-/// per corner; weight 0 for a zero-area face.
-std::array<std::pair<double, int>, 3> half_cotangents(const Mesh& mesh, FaceHandle f) {
+/// per corner; weight 0 for a zero-area face. `point(v)`: vertex v's position.
+template <class PointOf>
+std::array<std::pair<double, int>, 3> half_cotangents(const Mesh& mesh, FaceHandle f,
+                                                      const PointOf& point) {
   const HalfedgeHandle h0 = mesh.halfedge_handle(f);
   const HalfedgeHandle h1 = mesh.next_halfedge_handle(h0);
   const HalfedgeHandle h2 = mesh.next_halfedge_handle(h1);
   // Corner k sits opposite halfedge opposite[k].
   const std::array<HalfedgeHandle, 3> opposite{h1, h2, h0};
-  const std::array<Vec3, 3> p{mesh.point(mesh.from_vertex_handle(h0)),
-                              mesh.point(mesh.to_vertex_handle(h0)),
-                              mesh.point(mesh.to_vertex_handle(h1))};
+  const std::array<Vec3, 3> p{point(mesh.from_vertex_handle(h0)), point(mesh.to_vertex_handle(h0)),
+                              point(mesh.to_vertex_handle(h1))};
   // e[k] is the edge opposite corner k.
   const std::array<Vec3, 3> e{p[2] - p[1], p[0] - p[2], p[1] - p[0]};
   const std::array<double, 3> l{e[0].sqrnorm(), e[1].sqrnorm(), e[2].sqrnorm()};
@@ -53,12 +59,27 @@ std::array<std::pair<double, int>, 3> half_cotangents(const Mesh& mesh, FaceHand
 /// computed in parallel and added in face order: the same sums as one sequential loop.
 std::vector<double> edge_weights(const Mesh& mesh) {
   const auto halves = per_face<std::array<std::pair<double, int>, 3>>(
-      mesh, [&](FaceHandle f) { return half_cotangents(mesh, f); });
+      mesh, [&](FaceHandle f) { return half_cotangents(mesh, f, own_point(mesh)); });
   std::vector<double> weights(mesh.n_edges(), 0.0);
   for (const FaceHandle f : mesh.faces())
     for (const auto& [w, e] : halves[static_cast<std::size_t>(f.idx())])
       weights[static_cast<std::size_t>(e)] += w;
   return weights;
+}
+
+/// W_ij of edge e, its faces' halves added in face order, as edge_weights() adds them.
+template <class PointOf>
+double edge_weight(const Mesh& mesh, EdgeHandle e, const PointOf& point) {
+  FaceHandle faces[2] = {mesh.face_handle(mesh.halfedge_handle(e, 0)),
+                         mesh.face_handle(mesh.halfedge_handle(e, 1))};
+  if (faces[0].idx() > faces[1].idx()) std::swap(faces[0], faces[1]);
+  double w = 0.0;
+  for (const FaceHandle f : faces) {
+    if (!f.is_valid()) continue;
+    for (const auto& [half, edge] : half_cotangents(mesh, f, point))
+      if (edge == e.idx()) w += half;
+  }
+  return w;
 }
 
 } // namespace
@@ -68,17 +89,13 @@ std::vector<double> cotan_edge_weights(const Mesh& mesh) {
 }
 
 double cotan_weight(const Mesh& mesh, EdgeHandle e) {
-  // In face order, as edge_weights() adds them.
-  FaceHandle faces[2] = {mesh.face_handle(mesh.halfedge_handle(e, 0)),
-                         mesh.face_handle(mesh.halfedge_handle(e, 1))};
-  if (faces[0].idx() > faces[1].idx()) std::swap(faces[0], faces[1]);
-  double w = 0.0;
-  for (const FaceHandle f : faces) {
-    if (!f.is_valid()) continue;
-    for (const auto& [half, edge] : half_cotangents(mesh, f))
-      if (edge == e.idx()) w += half;
-  }
-  return w;
+  return edge_weight(mesh, e, own_point(mesh));
+}
+
+double cotan_weight(const Mesh& mesh, const Eigen::MatrixXd& points, EdgeHandle e) {
+  return edge_weight(mesh, e, [&](VertexHandle v) {
+    return Vec3(points(v.idx(), 0), points(v.idx(), 1), points(v.idx(), 2));
+  });
 }
 
 Eigen::SparseMatrix<double> weights_matrix(const Mesh& mesh, const std::vector<double>& weights) {

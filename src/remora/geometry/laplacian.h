@@ -15,6 +15,7 @@
 
 #include <vector>
 
+#include <Eigen/Core>
 #include <Eigen/SparseCore>
 
 #include "remora/mesh/mesh.h"
@@ -32,6 +33,9 @@ Eigen::SparseMatrix<double> cotan_weights(const Mesh& mesh);
 
 /// W_ij of the one edge e = (i, j), the same value as cotan_weights()'s entry.
 double cotan_weight(const Mesh& mesh, EdgeHandle e);
+/// The same at the positions `points` (a row per vertex idx(), 3 columns) instead of the mesh's
+/// own: what cotan_weights() gives for the mesh moved to them.
+double cotan_weight(const Mesh& mesh, const Eigen::MatrixXd& points, EdgeHandle e);
 
 /// W_ij of every edge, by edge idx() (0 for deleted edges): cotan_weights()'s off-diagonal
 /// entries without the matrix.

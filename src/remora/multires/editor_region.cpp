@@ -334,8 +334,9 @@ void Editor::Impl::find_affected(RegionState& r) const {
 }
 
 // Method nonlinear: its deformers from B0, the labels and the handles' scalar weights (the basis
-// functions' "1" columns); for a large support the coarse base of its preview, made once and
-// kept while the regions' sizes call for about the same coarse edge length.
+// functions' "1" columns); for a large support the coarse base of its preview, a remesh of the
+// support's part of the base, kept while later regions lie in it and call for about the same
+// coarse edge length.
 void Editor::Impl::build_nonlinear(RegionState& r, EditReport& into) {
   const auto t0 = Clock::now();
   Eigen::MatrixXd weights = Eigen::MatrixXd::Zero(r.rest.rows(), r.handles);
@@ -353,11 +354,11 @@ void Editor::Impl::build_nonlinear(RegionState& r, EditReport& into) {
                        o.energy != NonlinearEnergy::BlendedMotions && o.preview_vertices > 0 &&
                        n_free > 2 * static_cast<std::size_t>(o.preview_vertices);
   if (preview) {
-    const double wanted = coarse_length(mean_edge_length(base), n_free, o);
     r.coarse = coarse;
-    if (!r.coarse || std::abs(mean_edge_length(r.coarse->mesh) / wanted - 1.0) > 0.5) {
+    if (!r.coarse || !coarse_base_serves(*r.coarse, base, topology, r.free_vertices, o)) {
       const auto t1 = Clock::now();
-      r.coarse = std::make_shared<const RemeshResult>(make_coarse_base(base, n_free, o));
+      r.coarse = std::make_shared<const RemeshResult>(
+          make_coarse_base(base, topology, base_rest, r.free_vertices, o));
       into.milliseconds["nonlinear coarse base"] = ms_since(t1);
     }
   }

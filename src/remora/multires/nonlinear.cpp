@@ -95,7 +95,6 @@ struct NonlinearDeformer::Impl {
   Eigen::MatrixXd rhs_constrained; // nf × 3
   std::unique_ptr<Solver> solver;
   double edge_length = 1.0;
-  std::size_t negative_weights = 0; // of B0, clamped (both directions counted)
   NonlinearStats stats;
   double current_energy = 0.0;
   bool identity = true;
@@ -243,6 +242,7 @@ struct NonlinearDeformer::Impl {
   }
 
   void build(const Mesh& base, const Eigen::MatrixXd& rest_positions);
+  void read_rings(const Mesh& base, const Eigen::MatrixXd& rest_positions);
   void update_constrained_rhs();
   double max_move(const Eigen::VectorXd& u, const Eigen::VectorXd& v) const {
     double worst = 0.0;
@@ -255,6 +255,33 @@ struct NonlinearDeformer::Impl {
   Eigen::VectorXd anderson(const Eigen::VectorXd& g, const Eigen::VectorXd& f);
   void iterate();
 };
+
+// Each cell's row of W, the rest shape's own cotan weights (not B's: B0 can be far from B inside
+// the support) with negative ones clamped to 0, so that the global matrix stays positive
+// definite: its neighbours in increasing order, and the diagonal minus their sum.
+void NonlinearDeformer::Impl::read_rings(const Mesh& base, const Eigen::MatrixXd& rest_positions) {
+  ring_begin.assign(cells.size() + 1, 0);
+  for (std::size_t c = 0; c < cells.size(); ++c)
+    ring_begin[c + 1] = ring_begin[c] + static_cast<int>(base.valence(VertexHandle(cells[c])));
+  ring_vertex.resize(static_cast<std::size_t>(ring_begin.back()));
+  ring_weight.resize(ring_vertex.size());
+  diagonal.resize(cells.size());
+  parallel_for(cells.size(), options.threads, [&](std::size_t c) {
+    std::vector<std::pair<int, double>> ring;
+    for (const HalfedgeHandle h : base.voh_range(VertexHandle(cells[c])))
+      ring.emplace_back(base.to_vertex_handle(h).idx(),
+                        std::max(0.0, cotan_weight(base, rest_positions, base.edge_handle(h))));
+    std::sort(ring.begin(), ring.end());
+    double sum = 0.0;
+    auto k = static_cast<std::size_t>(ring_begin[c]);
+    for (const auto& [j, w] : ring) {
+      ring_vertex[k] = j;
+      ring_weight[k++] = w;
+      sum += w;
+    }
+    diagonal[c] = -sum;
+  });
+}
 
 void NonlinearDeformer::Impl::build(const Mesh& base, const Eigen::MatrixXd& rest_positions) {
   n = base.n_vertices();
@@ -281,51 +308,23 @@ void NonlinearDeformer::Impl::build(const Mesh& base, const Eigen::MatrixXd& res
     x = rest;
     return;
   }
-  // The rest shape's own cotan weights (not B's: B0 can be far from B inside the support), with
-  // negative ones clamped to 0 so that the global matrix stays positive definite.
-  Mesh shape = base;
-  set_positions(shape, rest_positions);
-  SparseMatrix w = cotan_weights(shape);
-  negative_weights = 0;
-  for (Eigen::Index col = 0; col < w.outerSize(); ++col)
-    for (SparseMatrix::InnerIterator it(w, col); it; ++it)
-      if (it.row() != it.col() && it.value() < 0.0) {
-        ++negative_weights;
-        it.valueRef() = 0.0;
-      }
-  for (Eigen::Index col = 0; col < w.outerSize(); ++col) { // the diagonal: minus the row's sum
-    double sum = 0.0;
-    for (SparseMatrix::InnerIterator it(w, col); it; ++it)
-      if (it.row() != it.col()) sum += it.value();
-    w.coeffRef(col, col) = -sum;
-  }
   // β = rigidity × (mean vertex area) / (the support's area) = rigidity / n_free: the two terms
   // keep their ratio when the base is refined or the shape scaled (docs/editing.md).
   if (a > 0.0 && !propagated) beta = options.rigidity / static_cast<double>(free_vertices.size());
+  // The cells: the free vertices and their neighbours.
   std::vector<char> in_cell(n, 0);
-  for (const int v : free_vertices)
-    for (SparseMatrix::InnerIterator it(w, v); it; ++it)
-      in_cell[static_cast<std::size_t>(it.row())] = 1;
+  for (const int v : free_vertices) {
+    in_cell[static_cast<std::size_t>(v)] = 1;
+    for (const VertexHandle u : base.vv_range(VertexHandle(v)))
+      in_cell[static_cast<std::size_t>(u.idx())] = 1;
+  }
   cell_of.assign(n, -1);
   for (std::size_t v = 0; v < n; ++v)
     if (in_cell[v]) {
       cell_of[v] = static_cast<int>(cells.size());
       cells.push_back(static_cast<int>(v));
     }
-  ring_begin.push_back(0);
-  for (const int m : cells) {
-    double d = 0.0;
-    for (SparseMatrix::InnerIterator it(w, m); it; ++it) {
-      if (it.row() == m) {
-        d += it.value();
-        continue;
-      }
-      ring_vertex.push_back(static_cast<int>(it.row()));
-      ring_weight.push_back(it.value());
-    }
-    diagonal.push_back(d);
-    ring_begin.push_back(static_cast<int>(ring_vertex.size()));
-  }
+  read_rings(base, rest_positions);
   rest = rest_positions;
   x = rest;
   delta.resize(static_cast<Eigen::Index>(cells.size()), 3);
@@ -334,16 +333,28 @@ void NonlinearDeformer::Impl::build(const Mesh& base, const Eigen::MatrixXd& res
   stretch.assign(cells.size(), Matrix3::Identity());
   rotation.assign(cells.size(), Matrix3::Identity());
 
-  // K = a (W²)_FF − 2β W_FF.
+  // K = a (W²)_FF − 2β W_FF, from the cells' rows of W: (W²)_FF = W_CFᵀ W_CF.
   const auto nfree = static_cast<Eigen::Index>(nf());
-  SparseMatrix select(static_cast<Eigen::Index>(n), nfree);
-  std::vector<Eigen::Triplet<double>> triplets;
-  for (std::size_t r = 0; r < nf(); ++r)
-    triplets.emplace_back(free_vertices[r], static_cast<Eigen::Index>(r), 1.0);
-  select.setFromTriplets(triplets.begin(), triplets.end());
-  const SparseMatrix wf = w * select;
-  SparseMatrix k = SparseMatrix(select.transpose() * wf) * (-2.0 * beta);
-  if (a > 0.0) k += a * SparseMatrix(wf.transpose() * wf);
+  std::vector<Eigen::Triplet<double>> cf, ff;
+  for (std::size_t c = 0; c < cells.size(); ++c) {
+    const int own = row_of[static_cast<std::size_t>(cells[c])];
+    const auto row = static_cast<Eigen::Index>(c);
+    if (own >= 0) {
+      cf.emplace_back(row, own, diagonal[c]);
+      ff.emplace_back(own, own, diagonal[c]);
+    }
+    for (int k = ring_begin[c]; k < ring_begin[c + 1]; ++k) {
+      const int j = row_of[static_cast<std::size_t>(ring_vertex[static_cast<std::size_t>(k)])];
+      if (j < 0) continue;
+      cf.emplace_back(row, j, ring_weight[static_cast<std::size_t>(k)]);
+      if (own >= 0) ff.emplace_back(own, j, ring_weight[static_cast<std::size_t>(k)]);
+    }
+  }
+  SparseMatrix wcf(static_cast<Eigen::Index>(cells.size()), nfree), wff(nfree, nfree);
+  wcf.setFromTriplets(cf.begin(), cf.end());
+  wff.setFromTriplets(ff.begin(), ff.end());
+  SparseMatrix k = wff * (-2.0 * beta);
+  if (a > 0.0) k += a * SparseMatrix(wcf.transpose() * wcf);
   const SparseMatrix kt = k.transpose();
   k = 0.5 * (k + kt);
   k.makeCompressed();

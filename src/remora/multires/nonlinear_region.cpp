@@ -8,6 +8,7 @@
 #include "remora/common/error.h"
 #include "remora/common/timer.h"
 #include "remora/geometry/measures.h"
+#include "remora/multires/face_patch.h"
 
 namespace remora {
 
@@ -17,13 +18,66 @@ double coarse_length(double base_length, std::size_t free_vertices,
   return base_length * std::max(2.0, std::sqrt(ratio));
 }
 
-RemeshResult make_coarse_base(const Mesh& base, std::size_t free_vertices,
+namespace {
+
+// A coarse base serves regions whose free vertices lie this many coarse edge lengths inside its
+// part of B, and is cut out with a wider margin, so that a region painted again a little larger
+// or beside the last one keeps it.
+constexpr double kServedMargin = 2.0, kCutMargin = 3.0;
+
+// B's faces within `margin` coarse edge lengths of the free vertices (counted in rings of B),
+// closed into a manifold part; in increasing order.
+std::vector<int> margin_faces(const Mesh& base, const TriangleTopology& t,
+                              const std::vector<int>& free_vertices, double base_length,
+                              double coarse, double margin) {
+  std::vector<char> in(t.faces.size(), 0);
+  std::vector<int> faces;
+  for (const int v : free_vertices) add_fan(t, v, in, faces);
+  grow_rings(t, static_cast<int>(std::ceil(margin * coarse / base_length)), in, faces);
+  close_patch(base, t, false, in, faces);
+  std::sort(faces.begin(), faces.end());
+  return faces;
+}
+
+} // namespace
+
+RemeshResult make_coarse_base(const Mesh& base, const TriangleTopology& topology,
+                              const Eigen::MatrixXd& points, const std::vector<int>& free_vertices,
                               const NonlinearOptions& options) {
+  const double base_length = mean_edge_length(base);
   RemeshOptions o;
-  o.target_length = coarse_length(mean_edge_length(base), free_vertices, options);
+  o.target_length = coarse_length(base_length, free_vertices.size(), options);
   o.compute_report = false;
   o.threads = options.threads;
-  return remesh(base, o);
+  const std::vector<int> faces =
+      margin_faces(base, topology, free_vertices, base_length, o.target_length, kCutMargin);
+  // Most of the base: the whole of it costs no more, and serves every later region.
+  if (2 * faces.size() > base.n_faces()) return remesh(base, o);
+  std::vector<int> local(base.n_vertices(), -1), vertices;
+  RemeshResult coarse = remesh(sub_mesh(topology, points, faces, local, vertices), o);
+  for (SurfacePoint& sp : coarse.output_on_input) // on the part's faces -> on B's
+    if (sp.face.is_valid()) sp.face = FaceHandle(faces[static_cast<std::size_t>(sp.face.idx())]);
+  std::vector<SurfacePoint> on_coarse(base.n_vertices(),
+                                      SurfacePoint{FaceHandle(), {1.0, 0.0, 0.0}});
+  for (std::size_t l = 0; l < vertices.size(); ++l)
+    on_coarse[static_cast<std::size_t>(vertices[l])] = coarse.input_on_output[l];
+  coarse.input_on_output = std::move(on_coarse);
+  return coarse;
+}
+
+bool coarse_base_serves(const RemeshResult& coarse, const Mesh& base,
+                        const TriangleTopology& topology, const std::vector<int>& free_vertices,
+                        const NonlinearOptions& options) {
+  const double base_length = mean_edge_length(base);
+  const double wanted = coarse_length(base_length, free_vertices.size(), options);
+  if (coarse.input_on_output.size() != base.n_vertices() ||
+      std::abs(mean_edge_length(coarse.mesh) / wanted - 1.0) > 0.5)
+    return false;
+  for (const int f :
+       margin_faces(base, topology, free_vertices, base_length, wanted, kServedMargin))
+    for (const int v : topology.faces[static_cast<std::size_t>(f)])
+      if (!coarse.input_on_output[static_cast<std::size_t>(v)].face.is_valid()) return false;
+  return true;
 }
 
 NonlinearRegion::NonlinearRegion(const Mesh& base, const RemeshResult* coarse,
