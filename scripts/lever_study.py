@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Why no deformation that agrees with the linear method to second order keeps a bent tube's rings.
 
-The study behind docs/editing.md ("Large rotations"), independent of Remora's code: a cylinder
+The study behind docs/nonlinear.md, independent of Remora's code: a cylinder
 (radius 1, height 4, 64 vertices around, 80 rings) with its bottom ring fixed and its top ring the
 handle, k = 2 (cotan Laplacian, barycentric areas), details encoded against the k-harmonic fill B0
 in a local frame per vertex and decoded in the deformed base's frames. It prints, for a 90° twist

@@ -187,7 +187,7 @@ TEST(Nonlinear, TheEnergyNeverIncreases) {
 // What the two methods share for small motions: on a flat support, bending (the handle lifted
 // along the normal or tilted about an in-plane axis) gives the same result to second order, the
 // difference shrinking like the square of the motion. (Where the support is curved, or the handle
-// moves in the plane, they differ at first order: docs/editing.md.)
+// moves in the plane, they differ at first order: docs/nonlinear.md.)
 TEST(Nonlinear, SmallBendingMotionsOfAFlatSupportAgreeWithLinearToSecondOrder) {
   const Mesh disc = make_disc(24, 6, 1.0);
   std::vector<int> support, handle;
@@ -306,7 +306,7 @@ TEST(Nonlinear, ANeedleCadMeshTurnsWithoutNan) {
 
 // Propagated rotations (NonlinearEnergy::PropagatedRotations): one solve, no iteration. Exact
 // at the identity and for one rigid motion of every constraint (the weights then sum to 1, so
-// every vertex gets that rotation); is the linear method on a flat support; keeps the cylinder's bumps, and its rings as measured (docs/editing.md).
+// every vertex gets that rotation); is the linear method on a flat support; keeps the cylinder's bumps, and its rings as measured (docs/nonlinear.md).
 EditorOptions propagated_options() {
   EditorOptions o = nonlinear_options();
   o.nonlinear.energy = NonlinearEnergy::PropagatedRotations;
@@ -340,7 +340,7 @@ TEST(NonlinearPropagated, KeepsTheCylindersBumpsAndBeatsTheLinearMethod) {
     std::cout << (twisted ? "twist" : "bend") << " 90 deg, propagated rotations: radius error "
               << p.worst_radius_error << ", bumps " << p.amplitude << "\n";
     // Measured 0.067 (twist) and 0.033 (bend): the rotations' variation along the axis shrinks
-    // the rings (docs/editing.md, "Large rotations").
+    // the rings (docs/nonlinear.md).
     EXPECT_LT(p.worst_radius_error, twisted ? 0.08 : 0.045);
     EXPECT_LT(p.worst_radius_error, 0.4 * l.worst_radius_error);
     EXPECT_GT(p.amplitude, 0.95);

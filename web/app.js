@@ -554,7 +554,7 @@ function setK(k) {
   if (state.movable && state.labels && !painting) task(() => sendRegion({ keepGizmo: true }));
 }
 /// The page's method choice as the API's: 'linear', 'nonlinear' (the server's default energy) or
-/// 'blended-motions' (method nonlinear with that energy: docs/editing.md, "Large rotations").
+/// 'blended-motions' (method nonlinear with that energy: docs/nonlinear.md).
 function methodRequest(choice) {
   if (choice === 'blended-motions') return { method: 'nonlinear', energy: 'blended-motions' };
   return { method: choice };

@@ -192,7 +192,7 @@ void add_edit_options(CLI::App* cmd, EditArgs& a) {
       ->check(CLI::IsMember({"linear", "nonlinear"}));
   cmd->add_option("--energy", a.energy,
                   "Method nonlinear: rotated-laplacian (default), propagated, blended-motions or "
-                  "arap (docs/editing.md, \"Large rotations\")")
+                  "arap (docs/nonlinear.md)")
       ->check(CLI::IsMember(nonlinear_energy_names()));
   cmd->add_option("--base-smoothing", a.base_smoothing,
                   "Low-pass length of the base surface, in mean edge lengths (area-based on needle "

@@ -53,7 +53,7 @@ void add_serve_command(CLI::App& app) {
       ->check(CLI::PositiveNumber);
   cmd->add_option("--energy", a->energy,
                   "Method nonlinear: rotated-laplacian (default), propagated, blended-motions or "
-                  "arap (docs/editing.md, \"Large rotations\")")
+                  "arap (docs/nonlinear.md)")
       ->check(CLI::IsMember(nonlinear_energy_names()));
   cmd->add_option("--history-editors", a->history_editors,
                   "Editors (one per bake) the undo history keeps alive (default 3); fewer raise "

@@ -21,7 +21,7 @@
 //   - weights summing to 1 and one rigid map of every handle: x = that map of p.
 // Rotations differ from the linear method at first order: the linear method moves a vertex by
 // its weight times the handle's own displacement (a lever at the handle), this by the blended
-// motion of the vertex itself (docs/editing.md, "Large rotations").
+// motion of the vertex itself (docs/nonlinear.md).
 #pragma once
 
 #include <vector>

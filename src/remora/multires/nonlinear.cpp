@@ -309,7 +309,7 @@ void NonlinearDeformer::Impl::build(const Mesh& base, const Eigen::MatrixXd& res
     return;
   }
   // β = rigidity × (mean vertex area) / (the support's area) = rigidity / n_free: the two terms
-  // keep their ratio when the base is refined or the shape scaled (docs/editing.md).
+  // keep their ratio when the base is refined or the shape scaled (docs/nonlinear.md).
   if (a > 0.0 && !propagated) beta = options.rigidity / static_cast<double>(free_vertices.size());
   // The cells: the free vertices and their neighbours.
   std::vector<char> in_cell(n, 0);

@@ -1,5 +1,5 @@
-// A nonlinear, rotation-invariant deformation of the editor's hidden base (docs/editing.md,
-// "Large rotations"). The linear method of Botsch & Kobbelt 2004 blends the handles' affine maps
+// A nonlinear, rotation-invariant deformation of the editor's hidden base (docs/nonlinear.md).
+// The linear method of Botsch & Kobbelt 2004 blends the handles' affine maps
 // linearly, so a rotated handle shears and shrinks the support (Botsch & Sorkine 2008, §4). This
 // deformer minimizes an energy that is invariant under rotations of the rest shape's local
 // pieces instead, by alternating a local step (one 3×3 rotation per vertex, Procrustes) and a

@@ -1,7 +1,7 @@
 // The nonlinear deformation (multires/nonlinear.h) on a coarse remesh of the base, carried to the
 // fine base as a correction of the linear result: what the editor shows while a handle is
-// dragged over a large support, until the fine iteration takes over (docs/editing.md, "Large
-// rotations"). The coarse level is a remesh of B at a longer edge length (the remesher of paper
+// dragged over a large support, until the fine iteration takes over (docs/nonlinear.md).
+// The coarse level is a remesh of B at a longer edge length (the remesher of paper
 // §4, as the multigrid hierarchy of §5.2 builds its levels), linked to B by the remesher's
 // correspondence both ways.
 //
