@@ -166,6 +166,31 @@ TEST(Nonlinear, TheCoarseBaseIsARemeshOfTheSupportsPartOfTheBase) {
   EXPECT_FALSE(coarse_base_serves(coarse, sphere, topology, cap, coarser));
 }
 
+// The editor keeps a region's coarse base for the next region painted in the same place (a
+// stroke that grows the support a little), and cuts out a new one elsewhere; either previews.
+TEST(Nonlinear, TheNextRegionInTheSamePlaceKeepsTheCoarseBase) {
+  const Mesh sphere = make_icosphere(5);
+  EditorOptions o = nonlinear_options();
+  o.remesh = false; // the base is the smoothed sphere on its own connectivity
+  o.nonlinear.preview_vertices = 300;
+  Editor editor(sphere, o);
+  const VertexHandle north = nearest_vertex(sphere, Vec3(0, 0, 1));
+  const VertexHandle south = nearest_vertex(sphere, Vec3(0, 0, -1));
+  const auto region = [&](VertexHandle seed, double radius) {
+    editor.set_region(select_geodesic_disc(sphere, seed, radius),
+                      {select_geodesic_disc(sphere, seed, 0.15)});
+    const Vec3 up = sphere.point(seed);
+    editor.set_transform(0, translation(0.3 * Eigen::Vector3d(up[0], up[1], up[2])));
+    const Eigen::MatrixXd p = editor.positions(1e-3);
+    EXPECT_TRUE(p.allFinite());
+    EXPECT_EQ(editor.report().nonlinear_level, "coarse");
+    return editor.report().milliseconds.count("nonlinear coarse base") > 0;
+  };
+  EXPECT_TRUE(region(north, 0.8));
+  EXPECT_FALSE(region(north, 0.83)); // kept
+  EXPECT_TRUE(region(south, 0.8));   // elsewhere: cut out again
+}
+
 TEST(Nonlinear, TheEnergyNeverIncreases) {
   const Cylinder c = bumpy_cylinder(24, 32);
   for (const int anderson : {0, 5}) {
