@@ -1,56 +1,19 @@
 #include "session.h"
 
 #include <algorithm>
-#include <atomic>
-#include <functional>
-#include <stop_token>
-#include <string_view>
 #include <utility>
 
 #include <fmt/format.h>
 
-#include "remora/common/memory.h"
 #include "remora/common/timer.h"
 #include "remora/geometry/measures.h"
 #include "remora/geometry/quality.h"
 #include "remora/linalg/kharmonic.h"
 #include "remora/mesh/io.h"
-#include "remora/multires/bake.h"
 #include "remora/multires/limits.h"
+#include "session_impl.h"
 
 namespace remora::server {
-
-// Named, not anonymous: Session::Impl holds these, and a unity build would otherwise give Impl
-// fields of internal linkage (GCC's -Wsubobject-linkage).
-namespace session_parts {
-
-struct RegionKey {
-  std::vector<int> support;
-  std::vector<std::vector<int>> handles;
-  int k = 2;
-  EditMethod method = EditMethod::Linear;
-  NonlinearEnergy energy = NonlinearEnergy::RotatedLaplacian; // method nonlinear's
-  bool operator==(const RegionKey&) const = default;
-};
-
-/// An editor and the region it currently has.
-struct EditorBox {
-  explicit EditorBox(Editor e) : editor(std::move(e)) {}
-  Editor editor;
-  std::optional<RegionKey> region;
-  double preprocess_ms = 0.0;
-  std::optional<BakeReport> bake; ///< how a bake made it (none for a load)
-};
-
-struct Snapshot {
-  std::shared_ptr<EditorBox> box;
-  std::optional<RegionKey> region;
-  std::vector<Transform> transforms;
-};
-
-} // namespace session_parts
-
-using namespace session_parts;
 
 namespace {
 
@@ -62,24 +25,6 @@ std::vector<float> movable_floats(const Editor& editor, const Eigen::MatrixXd& p
     for (int c = 0; c < 3; ++c)
       out[3 * i + static_cast<std::size_t>(c)] = static_cast<float>(p(movable[i], c));
   return out;
-}
-
-bool is_identity(const std::vector<Transform>& transforms) {
-  for (const Transform& t : transforms)
-    if (t != identity_transform()) return false;
-  return true;
-}
-
-/// Where a phase of the editor's preprocessing sits in the whole of it, as [begin, end)
-/// fractions: a rough split; the bar moves forward, it does not promise a time.
-std::pair<double, double> preprocess_share(std::string_view phase) {
-  if (phase == "reading") return {0.0, 0.05};
-  if (phase == "bake") return {0.0, 1.0}; // a local bake; a full one reports the phases below
-  if (phase == "base surface") return {0.05, 0.2};
-  if (phase == "remesh: remesh") return {0.2, 0.6};
-  if (phase == "remesh: equalize") return {0.6, 0.9};
-  if (phase == "remesh: correspondence") return {0.9, 0.97};
-  return {0.97, 1.0};
 }
 
 /// The steps of the last set_region (docs/editing.md) in ms; none for a region kept for an undo.
@@ -94,277 +39,61 @@ nlohmann::json set_region_parts(const EditReport& r) {
 
 } // namespace
 
-struct Session::Impl {
-  SessionOptions options;
-  mutable std::mutex mutex;
-  mutable std::atomic<int> waiting{0}; // callers blocked on `mutex`: a relax step gives way
-  std::unique_lock<std::mutex> acquire() const {
-    ++waiting;
-    std::unique_lock lock(mutex);
-    --waiting;
-    return lock;
-  }
-  std::condition_variable idle;
-  std::thread worker;
-  bool busy = false;
-  // The running job's stop request, and the job queued behind it (a new region stops a region job).
-  std::stop_source stop;
-  std::function<void(std::stop_token)> pending;
-  // A bake kept for the next region job when a newer region stopped the job after its bake.
-  std::shared_ptr<EditorBox> baked, baked_from;
-  std::vector<Transform> baked_transforms;
-  std::string job, phase; // what the worker does ("load", "region"), and its current phase
-  int step = 0, steps = 0;
-  double fraction = 0.0;                   // of the whole job
-  double span_begin = 0.0, span_end = 1.0; // the share of the job preprocessing takes
-  std::string error;                       // the last job's failure, if any
-  std::string name;                        // the mesh's file name
-  std::shared_ptr<EditorBox> box;          // current editor
-  std::optional<RegionKey> region;         // current region
-  std::vector<Transform> transforms;       // live transforms
-  std::vector<Snapshot> history;
-  std::size_t cursor = 0; // history[cursor] is the applied snapshot
-  double last_frame_ms = 0.0;
-  /// The shape lags the editor: a move went unanswered (set_transform without an answer).
-  bool shape_behind = false;
-  std::shared_ptr<Shape> shape; // what the page shows and paints on
-  // Change counters (status): the faces (a load), the positions other than through a frame of
-  // set_transform (load, undo, redo, a new k under moved handles), the region.
-  std::uint64_t mesh_id = 0, positions_id = 0, region_id = 0;
-
-  void require_ready() const {
-    if (busy) throw Busy(fmt::format("the session is busy ({}: {})", job, phase));
-    if (!box) throw Busy("no mesh is loaded yet: load one first");
-  }
-  void require_region() const {
-    require_ready();
-    if (!region) throw Busy("no region yet: paint a support and a handle first");
-  }
-  /// Base offsets are refused before anything changes where frame_base_offsets() refuses them.
-  void require_offsets(FrameAnswer answer) const {
-    const EditorOptions& o = box->editor.options();
-    if ((answer == FrameAnswer::BaseOffsets || answer == FrameAnswer::PositionsAndBaseOffsets) &&
-        o.method == EditMethod::Nonlinear && o.nonlinear.energy == NonlinearEnergy::BlendedMotions)
-      throw InvalidArgument("the energy blended-motions has no base offsets: its frames blend "
-                            "the handles' motions (answer \"positions\" or \"none\")");
-  }
-  void push_snapshot() {
-    if (!history.empty()) history.resize(cursor + 1); // drop the redo branch
-    history.push_back({box, region, transforms});
-    // Old snapshots go first when there are too many, or when they keep too many editors alive
-    // (each bake made one; an editor of a million-triangle mesh holds about a gigabyte).
-    auto editors = [&] {
-      std::vector<const EditorBox*> distinct;
-      for (const Snapshot& s : history)
-        if (std::find(distinct.begin(), distinct.end(), s.box.get()) == distinct.end())
-          distinct.push_back(s.box.get());
-      return distinct.size();
-    };
-    while (history.size() > 1 &&
-           (history.size() > options.max_history || editors() > options.max_editors))
-      history.erase(history.begin());
-    cursor = history.size() - 1;
-  }
-  /// Re-applies a snapshot (undo/redo): same editor, region and transforms, same positions.
-  void apply(const Snapshot& s) {
-    if (s.box != box || s.region != region) ++region_id;
-    box = s.box;
-    region = s.region;
-    transforms = s.transforms;
-    if (region && box->region != region) {
-      box->editor.set_system({region->k, box->editor.options().system.areas});
-      box->editor.set_method(region->method);
-      box->editor.set_region(region->support, region->handles);
-      box->region = region;
-    }
-    for (std::size_t j = 0; j < transforms.size(); ++j)
-      box->editor.set_transform(static_cast<int>(j), transforms[j]);
-    shape->set_positions(region ? box->editor.positions() : positions_matrix(box->editor.input()));
-    shape_behind = false;
-    ++positions_id;
-  }
-  /// The job's progress: `phase` at `s` of `n` steps; its fraction of the whole job from the
-  /// preprocessing shares. Call under the lock.
-  void report(std::string_view p, int s, int n) {
-    phase = std::string(p);
-    step = s;
-    steps = n;
-    if (p == "set_region") { // the rest of a region job: [span_end, 1]
-      fraction = span_end;
-      return;
-    }
-    const auto [begin, end] = preprocess_share(p);
-    const double within = n > 0 ? std::clamp(double(s) / n, 0.0, 1.0) : 0.0;
-    fraction = span_begin + (span_end - span_begin) * (begin + (end - begin) * within);
-  }
-  /// Runs `work` on the worker. A region job while one runs stops it and is queued behind it
-  /// (replacing one queued already); any other overlap throws Busy. Call under the lock.
-  void run(std::string what, std::function<void(std::stop_token)> work) {
-    if (busy) {
-      if (what == "region" && job == "region") {
-        stop.request_stop();
-        pending = std::move(work);
-        return;
-      }
-      throw Busy(fmt::format("the session is busy ({}: {})", job, phase));
-    }
-    if (worker.joinable()) worker.join();
-    busy = true;
-    job = std::move(what);
-    begin_job();
-    worker = std::thread([this, work = std::move(work), token = stop.get_token()]() mutable {
-      for (;;) {
-        try {
-          work(token);
-        } catch (const Cancelled&) {
-          // A newer region stopped it: that one runs next.
-        } catch (const std::exception& e) {
-          auto lock = acquire();
-          error = e.what();
-        }
-        auto lock = acquire();
-        if (pending) {
-          work = std::move(pending);
-          pending = nullptr;
-          begin_job();
-          token = stop.get_token();
-          continue;
-        }
-        busy = false;
-        phase.clear();
-        idle.notify_all();
-        return;
-      }
-    });
-  }
-  /// A job's start: a fresh stop request, no progress, no error. Call under the lock.
-  void begin_job() {
-    stop = std::stop_source();
-    phase = "starting";
-    step = steps = 0;
-    fraction = 0.0;
-    error.clear();
-  }
-  /// The editor that `current` under `moved_by` bakes into (the edited shape as a new input), or
-  /// the one a stopped job made for the same bake.
-  std::shared_ptr<EditorBox> bake_once(const std::shared_ptr<EditorBox>& current,
-                                       const std::vector<Transform>& moved_by) {
-    {
-      auto lock = acquire();
-      if (baked && baked_from == current && baked_transforms == moved_by) return baked;
-    }
-    // The edited shape becomes the next input: filtered and remeshed again where the edit
-    // changed it (multires/bake.h), or in full where that cannot work.
-    const auto t0 = Clock::now();
-    BakeResult result = remora::bake(current->editor);
-    auto next = std::make_shared<EditorBox>(std::move(result.editor));
-    next->preprocess_ms = ms_since(t0);
-    next->bake = std::move(result.report);
-    auto lock = acquire();
-    baked = next;
-    baked_from = current;
-    baked_transforms = moved_by;
-    return next;
-  }
-  /// What a region job does: bake first (a handle moved and the paint changed), solve the paint
-  /// again under the same transforms (k or the method changed), set a new region (paint or k).
-  struct RegionWork {
-    bool bake, resolve, new_region;
+void Session::Impl::push_snapshot() {
+  if (!history.empty()) history.resize(cursor + 1); // drop the redo branch
+  history.push_back({box, region, transforms});
+  // Old snapshots go first when there are too many, or when they keep too many editors alive
+  // (each bake made one; an editor of a million-triangle mesh holds about a gigabyte).
+  auto editors = [&] {
+    std::vector<const EditorBox*> distinct;
+    for (const Snapshot& s : history)
+      if (std::find(distinct.begin(), distinct.end(), s.box.get()) == distinct.end())
+        distinct.push_back(s.box.get());
+    return distinct.size();
   };
-  /// A region job: the bake, the region prepared, then installed unless a newer region stopped it.
-  void region_job(const RegionKey& key, RegionWork work, const std::shared_ptr<EditorBox>& current,
-                  const std::vector<Transform>& moved_by, const std::stop_token& token) {
-    {
-      auto lock = acquire();
-      span_begin = 0.0;
-      span_end = work.bake ? 0.85 : 0.0;
-    }
-    const std::shared_ptr<EditorBox> next = work.bake ? bake_once(current, moved_by) : current;
-    progress("set_region", 0, 1);
-    // The method and k are the editor's options for set_region; a failed or stopped job puts
-    // them back, so that it leaves the session as it was.
-    Editor& editor = next->editor;
-    const KHarmonicOptions previous_system = editor.options().system;
-    const EditMethod previous_method = editor.options().method;
-    const NonlinearEnergy previous_energy = editor.options().nonlinear.energy;
-    const auto restore = [&] {
-      editor.set_system(previous_system);
-      editor.set_method(previous_method);
-      editor.set_nonlinear_energy(previous_energy);
-    };
-    std::optional<Editor::Prepared> prepared;
-    try {
-      editor.set_system({key.k, previous_system.areas});
-      if (!token.stop_requested()) editor.prepare_regions(); // a new k (the load job: the first)
-      editor.set_method(key.method);
-      editor.set_nonlinear_energy(key.energy);
-      if (work.new_region) prepared = editor.prepare_region(key.support, key.handles, token);
-    } catch (...) {
-      restore();
-      throw;
-    }
-    auto lock = acquire();
-    if (token.stop_requested()) { // stale: the newer region is queued
-      restore();
-      return;
-    }
-    if (prepared) editor.install_region(std::move(*prepared));
-    next->region = key;
-    box = next;
-    region = key;
-    baked.reset();
-    baked_from.reset();
-    ++region_id;
-    if (work.resolve) {
-      for (std::size_t j = 0; j < moved_by.size(); ++j)
-        box->editor.set_transform(static_cast<int>(j), moved_by[j]);
-      shape->set_positions(box->editor.positions());
-      shape_behind = false;
-      ++positions_id;
-    } else {
-      transforms.assign(key.handles.size(), identity_transform());
-      // A move that went unanswered: the shape shows the new base (the baked move) in full,
-      // not only around the new region's movable vertices.
-      if (shape_behind) {
-        shape->set_positions(box->editor.positions());
-        shape_behind = false;
-      }
-    }
-    push_snapshot();
+  while (history.size() > 1 &&
+         (history.size() > options.max_history || editors() > options.max_editors))
+    history.erase(history.begin());
+  cursor = history.size() - 1;
+}
+
+/// Re-applies a snapshot (undo/redo): same editor, region and transforms, same positions.
+void Session::Impl::apply(const Snapshot& s) {
+  if (s.box != box || s.region != region) ++region_id;
+  box = s.box;
+  region = s.region;
+  transforms = s.transforms;
+  if (region && box->region != region) {
+    box->editor.set_system({region->k, box->editor.options().system.areas});
+    box->editor.set_method(region->method);
+    box->editor.set_region(region->support, region->handles);
+    box->region = region;
   }
-  /// positions(budget) of the editor, as the answer to a move or a relax step. Under the lock.
-  Frame frame(double budget_ms, FrameAnswer answer = FrameAnswer::Positions,
-              const std::function<bool()>& interrupt = {}) {
-    Editor& editor = box->editor;
-    const auto t0 = Clock::now();
-    Frame f;
-    const Eigen::MatrixXd& p = editor.positions(budget_ms, interrupt);
-    if (answer == FrameAnswer::Positions || answer == FrameAnswer::PositionsAndBaseOffsets)
-      f.positions = movable_floats(editor, p);
-    if (answer == FrameAnswer::BaseOffsets || answer == FrameAnswer::PositionsAndBaseOffsets)
-      f.base_offsets = frame_base_offsets(editor);
-    f.converged = editor.converged();
-    f.iterations = editor.report().method == "nonlinear" ? editor.report().nonlinear.iterations : 0;
-    f.ms = last_frame_ms = ms_since(t0);
-    shape->set_positions(editor.movable_vertices(), p);
-    shape_behind = false;
-    return f;
-  }
-  /// report() under the lock, then the options' own progress callback without it. On the worker.
-  void progress(std::string_view p, int s, int n) {
-    {
-      auto lock = acquire();
-      report(p, s, n);
-    }
-    if (options.editor.progress) options.editor.progress(p, s, n);
-  }
-  EditorOptions editor_options() {
-    EditorOptions o = options.editor;
-    o.threads = options.threads;
-    o.progress = [this](std::string_view p, int s, int n) { progress(p, s, n); };
-    return o;
-  }
-};
+  for (std::size_t j = 0; j < transforms.size(); ++j)
+    box->editor.set_transform(static_cast<int>(j), transforms[j]);
+  shape->set_positions(region ? box->editor.positions() : positions_matrix(box->editor.input()));
+  shape_behind = false;
+  ++positions_id;
+}
+
+/// positions(budget) of the editor, as the answer to a move or a relax step. Under the lock.
+Frame Session::Impl::frame(double budget_ms, FrameAnswer answer,
+                           const std::function<bool()>& interrupt) {
+  Editor& editor = box->editor;
+  const auto t0 = Clock::now();
+  Frame f;
+  const Eigen::MatrixXd& p = editor.positions(budget_ms, interrupt);
+  if (answer == FrameAnswer::Positions || answer == FrameAnswer::PositionsAndBaseOffsets)
+    f.positions = movable_floats(editor, p);
+  if (answer == FrameAnswer::BaseOffsets || answer == FrameAnswer::PositionsAndBaseOffsets)
+    f.base_offsets = frame_base_offsets(editor);
+  f.converged = editor.converged();
+  f.iterations = editor.report().method == "nonlinear" ? editor.report().nonlinear.iterations : 0;
+  f.ms = last_frame_ms = ms_since(t0);
+  shape->set_positions(editor.movable_vertices(), p);
+  shape_behind = false;
+  return f;
+}
 
 Session::Session(SessionOptions options) : impl_(std::make_unique<Impl>()) {
   impl_->options = std::move(options);
@@ -387,87 +116,6 @@ std::size_t Session::vertex_count() const {
 void Session::wait_for(std::chrono::milliseconds timeout) {
   auto lock = impl_->acquire();
   impl_->idle.wait_for(lock, timeout, [&] { return !impl_->busy; });
-}
-
-void Session::start_load(std::string bytes, std::string name) {
-  auto lock = impl_->acquire();
-  const MeshFormat format = format_from_path(name); // IoError for an unknown extension at once
-  impl_->run("load", [this, bytes = std::move(bytes), name, format](std::stop_token) {
-    Impl& m = *impl_;
-    const auto t0 = Clock::now();
-    {
-      std::lock_guard guard(m.mutex);
-      m.span_begin = 0.0;
-      m.span_end = 1.0;
-    }
-    m.progress("reading", 0, 1);
-    LoadResult loaded = read_mesh_from_memory(bytes, format, name, {}, m.options.read);
-    auto shape = std::make_shared<Shape>(loaded.mesh);
-    auto box = std::make_shared<EditorBox>(Editor(std::move(loaded.mesh), m.editor_options()));
-    // The first regions' factors then find warm pages (common/memory.h).
-    warm_heap(warm_heap_bytes(box->editor.base().n_vertices(), box->editor.options().system.k));
-    // The regions' systems then come from one set of rows and their factors follow one order of
-    // the base (docs/solvers.md).
-    box->editor.prepare_regions();
-    box->preprocess_ms = ms_since(t0);
-    std::lock_guard guard(m.mutex);
-    m.box = box;
-    m.shape = std::move(shape);
-    m.shape_behind = false;
-    ++m.mesh_id;
-    ++m.positions_id;
-    ++m.region_id;
-    m.name = name;
-    m.region.reset();
-    m.transforms.clear();
-    m.history.clear();
-    m.push_snapshot();
-  });
-}
-
-void Session::start_region(std::vector<int> support, std::vector<std::vector<int>> handles, int k,
-                           EditMethod method, std::optional<NonlinearEnergy> energy) {
-  auto lock = impl_->acquire();
-  Impl& m = *impl_;
-  if (!(m.busy && m.job == "region")) m.require_ready(); // a region job: stopped and followed
-  if (k < 1 || k > 3) throw InvalidArgument(fmt::format("k = {} is not 1, 2 or 3", k));
-  if (handles.size() > static_cast<std::size_t>(m.options.max_handles))
-    throw InvalidArgument(fmt::format("{} handles: at most {} are accepted (remora serve "
-                                      "--max-handles)",
-                                      handles.size(), m.options.max_handles));
-  const auto n = static_cast<int>(m.box->editor.input().n_vertices());
-  // Longer lists can only repeat ids: refused before any work sized by them.
-  const auto too_long = [n](std::size_t size) { return size > static_cast<std::size_t>(n); };
-  if (too_long(support.size()) || std::any_of(handles.begin(), handles.end(),
-                                              [&](const auto& h) { return too_long(h.size()); }))
-    throw InvalidArgument(
-        fmt::format("a region lists more ids than the mesh has vertices ({})", n));
-  for (const int v : support)
-    if (v < 0 || v >= n)
-      throw InvalidArgument(fmt::format("support vertex {} is out of range (the mesh has {} "
-                                        "vertices)",
-                                        v, n));
-  for (const auto& h : handles)
-    for (const int v : h)
-      if (v < 0 || v >= n)
-        throw InvalidArgument(fmt::format("handle vertex {} is out of range (the mesh has {} "
-                                          "vertices)",
-                                          v, n));
-  RegionKey key{std::move(support), std::move(handles), k, method,
-                energy.value_or(m.options.editor.nonlinear.energy)};
-  // Only k or the method changes: the same handles keep their transforms, solved again (no
-  // bake), so that a user compares them on the same drag. A new method alone needs no new
-  // set_region.
-  const bool same_paint =
-      m.region && m.region->support == key.support && m.region->handles == key.handles;
-  const bool resolve = same_paint && (m.region->k != key.k || m.region->method != key.method ||
-                                      m.region->energy != key.energy);
-  const bool new_region = !resolve || m.region->k != key.k;
-  const bool bake = !resolve && !is_identity(m.transforms);
-  m.run("region", [this, key = std::move(key), bake, resolve, new_region, current = m.box,
-                   moved_by = m.transforms](std::stop_token token) {
-    impl_->region_job(key, {bake, resolve, new_region}, current, moved_by, token);
-  });
 }
 
 Frame Session::set_transform(int handle, const Transform& transform, FrameAnswer answer) {
