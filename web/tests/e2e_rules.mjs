@@ -403,8 +403,12 @@ export async function kernelAgrees(page, c, rest, region, dragged, what = 'the p
   // Both engines: kernel.wasm (the library's replay) where the build has it, and the JavaScript.
   const engine = await page.evaluate(() => window.remora.kernelEngine());
   const wasmBuilt = existsSync(join(args['web-root'] ?? '', 'kernel.wasm'));
-  const threads = await page.evaluate(() => window.remora.kernelThreads());
   const cores = await page.evaluate(() => navigator.hardwareConcurrency);
+  // A new region's frame worker starts with the region's kernel; on a loaded machine it may not
+  // have answered yet (until then the page's thread evaluates the whole frame).
+  if (engine === 'wasm' && cores >= 2)
+    await page.waitForFunction(() => window.remora.kernelThreads() >= 2, null, { timeout: 10000 }).catch(() => {});
+  const threads = await page.evaluate(() => window.remora.kernelThreads());
   check(engine === (wasmBuilt ? 'wasm' : 'js') && (engine === 'js' || threads === Math.min(2, cores)),
         `${what} runs in ${engine} on ${threads} threads (kernel.wasm ${wasmBuilt ? '' : 'not '}built, ${cores} cores)`);
   const js = await page.evaluate((t) => window.remora.kernelFrame([t], 'js'), rows);
