@@ -166,6 +166,36 @@ TEST(Nonlinear, TheCoarseBaseIsARemeshOfTheSupportsPartOfTheBase) {
   EXPECT_FALSE(coarse_base_serves(coarse, sphere, topology, cap, coarser));
 }
 
+// Cut out of an open mesh where the margin reaches its border (an annulus's inner hole): the part
+// keeps that border, and the coarse base still covers the free vertices and lies on the base.
+TEST(Nonlinear, TheCoarseBaseIsCutOutAcrossTheMeshsBorder) {
+  const Mesh annulus = make_annulus(40, 160, 0.3, 1.0); // 6,560 vertices
+  const TriangleTopology topology = triangle_topology(annulus);
+  const Eigen::MatrixXd points = positions_matrix(annulus);
+  const VertexHandle seed = nearest_vertex(annulus, Vec3(0.45, 0, 0));
+  const std::vector<int> support = select_geodesic_disc(annulus, seed, 0.4); // round the hole
+  NonlinearOptions o;
+  o.preview_vertices = 200;
+  const RemeshResult coarse = make_coarse_base(annulus, topology, points, support, o);
+  const double length = mean_edge_length(coarse.mesh);
+  EXPECT_LT(coarse.mesh.n_vertices(), support.size());
+  for (const int v : support) {
+    const SurfacePoint& sp = coarse.input_on_output[static_cast<std::size_t>(v)];
+    ASSERT_TRUE(sp.face.is_valid()) << v;
+    EXPECT_LT((evaluate(coarse.mesh, sp) - annulus.point(VertexHandle(v))).norm(), 0.1 * length);
+  }
+  for (const VertexHandle c : coarse.mesh.vertices()) {
+    const SurfacePoint& sp = coarse.output_on_input[static_cast<std::size_t>(c.idx())];
+    ASSERT_TRUE(sp.face.is_valid());
+    EXPECT_LT((evaluate(annulus, sp) - coarse.mesh.point(c)).norm(), 1e-9);
+  }
+  EXPECT_FALSE(coarse
+                   .input_on_output[static_cast<std::size_t>(
+                       nearest_vertex(annulus, Vec3(-0.9, 0, 0)).idx())]
+                   .face.is_valid());
+  EXPECT_TRUE(coarse_base_serves(coarse, annulus, topology, support, o));
+}
+
 // The editor keeps a region's coarse base for the next region painted in the same place (a
 // stroke that grows the support a little), and cuts out a new one elsewhere; either previews.
 TEST(Nonlinear, TheNextRegionInTheSamePlaceKeepsTheCoarseBase) {
