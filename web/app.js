@@ -9,7 +9,7 @@ import { ApiError, api, binary, compactIds, json, message, post, task, waitUntil
 import * as view from './view.js';
 import { FIXED, FREE } from './view.js';
 import { Coalescer, faceNormal, pick } from './picking.js';
-import { RegionKernel, methodOf, sendFrame } from './drag_frames.js';
+import { RegionKernel, Relaxer, methodOf, sendFrame } from './drag_frames.js';
 import { engine, loadEngine } from './engine.js';
 import * as panels from './panels.js';
 
@@ -289,8 +289,7 @@ function regionLists() {
 let regionSeq = 0, regionPosted = Promise.resolve();
 async function sendRegion({ keepGizmo = false, inStroke = false } = {}) {
   const started = performance.now(), seq = ++regionSeq;
-  clearTimeout(relaxTimer);
-  relaxTimer = null;
+  relaxer.cancel();
   state.dirtyRegion = false;
   const { support, handles, free } = regionLists();
   showHandleButtons();
@@ -411,8 +410,7 @@ function matrixToRows(m) {
 }
 
 // A frame: a handle's new map, or, while the pointer rests, more nonlinear iterations in steps
-const RELAX_PAUSE_MS = 120, RELAX_BUDGET_MS = 40, RELAX_BUDGET_MAX_MS = 320; // whose budget doubles
-let lastMove = 0, relaxTimer = null, relaxSteps = 0;
+// (drag_frames.js's Relaxer).
 /// A corrected kernel takes the answer's base offsets (those of the kernel the request was sent
 /// with); after the drag's last move the page's frame is shown again with them.
 function receiveOffsets(result, request) {
@@ -424,16 +422,16 @@ function receiveOffsets(result, request) {
   state.marks.dragServer.push(result.ms);
   state.marks.dragTrip.push(received - request.sent);
   state.converged = result.converged;
-  if (!result.converged) relaxSoon();
+  if (!result.converged) relaxer.soon();
 }
-const frames = new Coalescer((request) => sendFrame(request, request.budget ?? RELAX_BUDGET_MS), (result, request) => {
+const frames = new Coalescer((request) => sendFrame(request, request.budget ?? Relaxer.BUDGET_MS), (result, request) => {
   receiveOffsets(result, request);
   if (request.local) return; // shown by localFrame(), which also timed it
   if (!state.movable || result.moved.length !== 3 * state.movable.length) return;
   state.frameMs = result.ms;
   const received = performance.now();
   // A move after the request was sent is shown already by the page's frame: keep it.
-  if (lastMove > request.sent && kernelUsable()) showKernelFrame();
+  if (relaxer.lastMove > request.sent && kernelUsable()) showKernelFrame();
   else view.applyMoved(state.movable, result.moved);
   if (!request.relax && !request.last) {
     const done = performance.now();
@@ -448,23 +446,11 @@ const frames = new Coalescer((request) => sendFrame(request, request.budget ?? R
     state.marks.relaxed.push(performance.now() - state.marks.dragEnd);
     state.marks.dragEnd = null;
   }
-  if (!result.converged) relaxSoon();
+  if (!result.converged) relaxer.soon();
   else if (request.relax) task(refreshStatus);
 });
-/// While the nonlinear iteration is not converged: once the pointer has rested RELAX_PAUSE_MS,
-/// ask for more iterations (a newer move replaces a waiting relax request).
-function relaxSoon() {
-  clearTimeout(relaxTimer);
-  const wait = Math.max(0, lastMove + RELAX_PAUSE_MS - performance.now());
-  relaxTimer = setTimeout(() => {
-    relaxTimer = null;
-    const budget = Math.min(RELAX_BUDGET_MAX_MS, RELAX_BUDGET_MS * 2 ** relaxSteps);
-    if (!frames.pending && performance.now() - lastMove >= RELAX_PAUSE_MS) {
-      frames.submit({ relax: true, budget, offsets: kernelCorrected(), kernel });
-      ++relaxSteps;
-    } else if (!frames.pending) relaxSoon();
-  }, wait);
-}
+const relaxer = new Relaxer((budget) => frames.submit({ relax: true, budget, offsets: kernelCorrected(), kernel }),
+                            () => frames.pending);
 async function refreshStatus() {
   try { state.status = await json('status'); panels.showStats(state.status, state.frameMs); } catch (e) { /* shown */ }
   if (state.status?.nonlinear?.fallback) message(state.status.nonlinear.fallback, 'hint');
@@ -483,7 +469,7 @@ gizmo.addEventListener('dragging-changed', (event) => {
   }
   dragStart = null;
   state.marks.dragEnd = performance.now();
-  lastMove = Math.min(lastMove, state.marks.dragEnd - RELAX_PAUSE_MS); // released: no pause to wait for
+  relaxer.released(state.marks.dragEnd);
   const handle = state.selected, last = draggedLocally;
   task(async () => {
     // The page showed its own frames: the drag ends on the server's (the reference).
@@ -500,11 +486,11 @@ gizmo.addEventListener('objectChange', () => {
   pivot.updateMatrix();
   const t = pivot.matrix.clone().multiply(dragStart).multiply(dragBase);
   state.transforms[state.selected] = t;
-  lastMove = performance.now();
-  relaxSteps = 0;
-  const local = localFrame(lastMove);
+  const now = performance.now();
+  relaxer.moved(now);
+  const local = localFrame(now);
   draggedLocally ||= local;
-  frames.submit({ handle: state.selected, matrix: matrixToRows(t), t0: lastMove, local, offsets: kernelCorrected(), kernel });
+  frames.submit({ handle: state.selected, matrix: matrixToRows(t), t0: now, local, offsets: kernelCorrected(), kernel });
 });
 
 // ---- the base surface ---------------------------------------------------------------------------
@@ -678,7 +664,7 @@ window.remora = {
     for (let i = 0; i < n.length; i += 3) worst = Math.max(worst, 1 - Math.max(Math.abs(n[i]), Math.abs(n[i + 1]), Math.abs(n[i + 2])));
     return worst;
   },
-  ready: () => !!view.shown.mesh && work.tasks === 0 && !frames.busy && relaxTimer === null && !picks.busy &&
+  ready: () => !!view.shown.mesh && work.tasks === 0 && !frames.busy && relaxer.idle && !picks.busy &&
                state.status?.state === 'ready',
   converged: () => state.converged,
   method: () => state.method,

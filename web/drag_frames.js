@@ -45,6 +45,41 @@ export class RegionKernel {
   evaluate(transforms, out = this.out, how = 'wasm') { return evaluateKernel(this.data, transforms, out, how); }
 }
 
+/// While the nonlinear iteration is not converged, more iterations once the pointer has rested
+/// PAUSE_MS (soon()), in relax steps whose budget doubles from BUDGET_MS to BUDGET_MAX_MS: a
+/// step's answer that is not converged asks for the next; a move (moved()) starts over, and a
+/// release (released()) has no pause to wait for. `submit(budget)` sends a step; `pending()`:
+/// a request waits to be sent (a newer move replaces a waiting step).
+export class Relaxer {
+  static PAUSE_MS = 120;
+  static BUDGET_MS = 40;
+  static BUDGET_MAX_MS = 320;
+  constructor(submit, pending) { Object.assign(this, { submit, pending, lastMove: 0, timer: null, steps: 0 }); }
+  moved(now) {
+    this.lastMove = now;
+    this.steps = 0;
+  }
+  released(at) { this.lastMove = Math.min(this.lastMove, at - Relaxer.PAUSE_MS); }
+  /// No step is waiting for its pause.
+  get idle() { return this.timer === null; }
+  cancel() {
+    clearTimeout(this.timer);
+    this.timer = null;
+  }
+  soon() {
+    clearTimeout(this.timer);
+    const wait = Math.max(0, this.lastMove + Relaxer.PAUSE_MS - performance.now());
+    this.timer = setTimeout(() => {
+      this.timer = null;
+      const budget = Math.min(Relaxer.BUDGET_MAX_MS, Relaxer.BUDGET_MS * 2 ** this.steps);
+      if (!this.pending() && performance.now() - this.lastMove >= Relaxer.PAUSE_MS) {
+        this.submit(budget);
+        ++this.steps;
+      } else if (!this.pending()) this.soon();
+    }, wait);
+  }
+}
+
 /// What a frame request asks the server to answer: the movable vertices' positions, none for a
 /// frame the page showed itself, and for a corrected kernel the base offsets after them.
 function frameAnswer(request) {
