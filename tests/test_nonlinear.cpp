@@ -134,16 +134,17 @@ TEST(Nonlinear, TheCoarseBaseIsARemeshOfTheSupportsPartOfTheBase) {
   const Mesh sphere = make_icosphere(5); // 10,242 vertices, edge about 0.038
   const TriangleTopology topology = triangle_topology(sphere);
   const Eigen::MatrixXd points = positions_matrix(sphere);
+  const double edge = mean_edge_length(sphere);
   const VertexHandle north = nearest_vertex(sphere, Vec3(0, 0, 1));
   const VertexHandle south = nearest_vertex(sphere, Vec3(0, 0, -1));
   NonlinearOptions o;
   o.preview_vertices = 300;
   const std::vector<int> cap = select_geodesic_disc(sphere, north, 0.8); // about 1,600
-  const RemeshResult coarse = make_coarse_base(sphere, topology, points, cap, o);
+  const RemeshResult coarse = make_coarse_base(sphere, topology, points, edge, cap, o);
   ASSERT_EQ(coarse.input_on_output.size(), sphere.n_vertices());
   ASSERT_EQ(coarse.output_on_input.size(), coarse.mesh.n_vertices());
   const double length = mean_edge_length(coarse.mesh);
-  EXPECT_NEAR(length / coarse_length(mean_edge_length(sphere), cap.size(), o), 1.0, 0.25);
+  EXPECT_NEAR(length / coarse_length(edge, cap.size(), o), 1.0, 0.25);
   EXPECT_LT(coarse.mesh.n_vertices(), cap.size()); // a part, coarser
   for (const int v : cap) {
     const SurfacePoint& sp = coarse.input_on_output[static_cast<std::size_t>(v)];
@@ -156,14 +157,14 @@ TEST(Nonlinear, TheCoarseBaseIsARemeshOfTheSupportsPartOfTheBase) {
     ASSERT_TRUE(sp.face.is_valid());
     EXPECT_LT((evaluate(sphere, sp) - coarse.mesh.point(c)).norm(), 1e-9);
   }
-  EXPECT_TRUE(coarse_base_serves(coarse, sphere, topology, cap, o));
-  EXPECT_TRUE(
-      coarse_base_serves(coarse, sphere, topology, select_geodesic_disc(sphere, north, 0.83), o));
-  EXPECT_FALSE(
-      coarse_base_serves(coarse, sphere, topology, select_geodesic_disc(sphere, south, 0.8), o));
+  EXPECT_TRUE(coarse_base_serves(coarse, sphere, topology, edge, cap, o));
+  EXPECT_TRUE(coarse_base_serves(coarse, sphere, topology, edge,
+                                 select_geodesic_disc(sphere, north, 0.83), o));
+  EXPECT_FALSE(coarse_base_serves(coarse, sphere, topology, edge,
+                                  select_geodesic_disc(sphere, south, 0.8), o));
   NonlinearOptions coarser = o; // the same region previewed at a third of the vertices
   coarser.preview_vertices = 100;
-  EXPECT_FALSE(coarse_base_serves(coarse, sphere, topology, cap, coarser));
+  EXPECT_FALSE(coarse_base_serves(coarse, sphere, topology, edge, cap, coarser));
 }
 
 // Cut out of an open mesh where the margin reaches its border (an annulus's inner hole): the part
@@ -172,11 +173,12 @@ TEST(Nonlinear, TheCoarseBaseIsCutOutAcrossTheMeshsBorder) {
   const Mesh annulus = make_annulus(40, 160, 0.3, 1.0); // 6,560 vertices
   const TriangleTopology topology = triangle_topology(annulus);
   const Eigen::MatrixXd points = positions_matrix(annulus);
+  const double edge = mean_edge_length(annulus);
   const VertexHandle seed = nearest_vertex(annulus, Vec3(0.45, 0, 0));
   const std::vector<int> support = select_geodesic_disc(annulus, seed, 0.4); // round the hole
   NonlinearOptions o;
   o.preview_vertices = 200;
-  const RemeshResult coarse = make_coarse_base(annulus, topology, points, support, o);
+  const RemeshResult coarse = make_coarse_base(annulus, topology, points, edge, support, o);
   const double length = mean_edge_length(coarse.mesh);
   EXPECT_LT(coarse.mesh.n_vertices(), support.size());
   for (const int v : support) {
@@ -193,7 +195,7 @@ TEST(Nonlinear, TheCoarseBaseIsCutOutAcrossTheMeshsBorder) {
                    .input_on_output[static_cast<std::size_t>(
                        nearest_vertex(annulus, Vec3(-0.9, 0, 0)).idx())]
                    .face.is_valid());
-  EXPECT_TRUE(coarse_base_serves(coarse, annulus, topology, support, o));
+  EXPECT_TRUE(coarse_base_serves(coarse, annulus, topology, edge, support, o));
 }
 
 // The editor keeps a region's coarse base for the next region painted in the same place (a

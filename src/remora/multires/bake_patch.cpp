@@ -5,7 +5,6 @@
 #include <fmt/format.h>
 
 #include "remora/geometry/measures.h"
-#include "remora/mesh/build.h"
 #include "remora/mesh/topology.h"
 #include "remora/multires/bake_steps.h"
 #include "remora/multires/face_patch.h"

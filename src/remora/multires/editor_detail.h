@@ -7,6 +7,7 @@
 #include <deque>
 #include <functional>
 #include <memory>
+#include <mutex>
 #include <optional>
 #include <stop_token>
 #include <string>
@@ -15,6 +16,7 @@
 
 #include <Eigen/Core>
 
+#include "remora/geometry/measures.h"
 #include "remora/multires/editor.h"
 #include "remora/multires/frame.h"
 #include "remora/multires/limits.h"
@@ -63,6 +65,14 @@ struct Editor::Impl : EditorParts {
   EditorOptions options;
   std::unique_ptr<MultigridSolver> multigrid;
   std::shared_ptr<const RemeshResult> coarse; // method nonlinear's preview level, for every region
+  // B's mean edge length, measured the first time a preview needs it (a region may be prepared
+  // on the session's worker while a frame builds another's nonlinear state).
+  std::once_flag base_length_once;
+  double base_length = 0.0;
+  double mean_base_length() {
+    std::call_once(base_length_once, [&] { base_length = mean_edge_length(base); });
+    return base_length;
+  }
   std::unique_ptr<RegionState> region;
   // For each input vertex i, the base vertices whose location on the input (base_on_input) has
   // i as its nearest corner: base_nearest[base_nearest_begin[i] .. base_nearest_begin[i + 1]).

@@ -353,24 +353,23 @@ void Editor::Impl::build_nonlinear(RegionState& r, EditReport& into) {
   const bool preview = o.energy != NonlinearEnergy::PropagatedRotations &&
                        o.energy != NonlinearEnergy::BlendedMotions && o.preview_vertices > 0 &&
                        n_free > 2 * static_cast<std::size_t>(o.preview_vertices);
-  bool coarse_ok = preview;
   if (preview) {
+    const double length = mean_base_length();
     r.coarse = coarse;
-    if (!r.coarse || !coarse_base_serves(*r.coarse, base, topology, r.free_vertices, o)) {
+    if (!r.coarse || !coarse_base_serves(*r.coarse, base, topology, length, r.free_vertices, o)) {
       const auto t1 = Clock::now();
       try {
         r.coarse = std::make_shared<const RemeshResult>(
-            make_coarse_base(base, topology, base_rest, r.free_vertices, o));
+            make_coarse_base(base, topology, base_rest, length, r.free_vertices, o));
       } catch (const Error&) { // no preview: the fine level alone, which works
         r.coarse.reset();
-        coarse_ok = false;
       }
       into.milliseconds["nonlinear coarse base"] = ms_since(t1);
     }
   }
   r.nonlinear_energy = o.energy;
-  r.nonlinear = std::make_unique<NonlinearRegion>(base, coarse_ok ? r.coarse.get() : nullptr,
-                                                  r.rest, r.base_label, weights, o);
+  r.nonlinear = std::make_unique<NonlinearRegion>(base, preview ? r.coarse.get() : nullptr, r.rest,
+                                                  r.base_label, weights, o);
   into.milliseconds["nonlinear setup"] = ms_since(t0);
 }
 

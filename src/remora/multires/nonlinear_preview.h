@@ -1,9 +1,9 @@
 // The nonlinear deformation (multires/nonlinear.h) on a coarse remesh of the base, carried to the
 // fine base as a correction of the linear result: what the editor shows while a handle is
 // dragged over a large support, until the fine iteration takes over (docs/nonlinear.md).
-// The coarse level is a remesh of B at a longer edge length (the remesher of paper
-// §4, as the multigrid hierarchy of §5.2 builds its levels), linked to B by the remesher's
-// correspondence both ways.
+// The coarse level is a remesh of B, or of its part around the support (make_coarse_base() of
+// nonlinear_region.h), at a longer edge length (the remesher of paper §4, as the multigrid
+// hierarchy of §5.2 builds its levels), linked to B by the remesher's correspondence both ways.
 //
 // With lin the fine linear result, R lin its values at the coarse vertices' places on B
 // (barycentric interpolation) and x_c the coarse nonlinear solution started from R lin, the fine

@@ -42,9 +42,9 @@ std::vector<int> margin_faces(const Mesh& base, const TriangleTopology& t,
 } // namespace
 
 RemeshResult make_coarse_base(const Mesh& base, const TriangleTopology& topology,
-                              const Eigen::MatrixXd& points, const std::vector<int>& free_vertices,
+                              const Eigen::MatrixXd& points, double base_length,
+                              const std::vector<int>& free_vertices,
                               const NonlinearOptions& options) {
-  const double base_length = mean_edge_length(base);
   RemeshOptions o;
   o.target_length = coarse_length(base_length, free_vertices.size(), options);
   o.compute_report = false;
@@ -66,9 +66,8 @@ RemeshResult make_coarse_base(const Mesh& base, const TriangleTopology& topology
 }
 
 bool coarse_base_serves(const RemeshResult& coarse, const Mesh& base,
-                        const TriangleTopology& topology, const std::vector<int>& free_vertices,
-                        const NonlinearOptions& options) {
-  const double base_length = mean_edge_length(base);
+                        const TriangleTopology& topology, double base_length,
+                        const std::vector<int>& free_vertices, const NonlinearOptions& options) {
   const double wanted = coarse_length(base_length, free_vertices.size(), options);
   if (coarse.input_on_output.size() != base.n_vertices() ||
       std::abs(mean_edge_length(coarse.mesh) / wanted - 1.0) > 0.5)

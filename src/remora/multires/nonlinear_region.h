@@ -32,17 +32,18 @@ namespace remora {
 /// support, not the base; the whole of B when that part holds more than half its faces. With
 /// both correspondences on the whole of B: output_on_input on B's
 /// faces, input_on_output a point on the coarse mesh for every vertex of the cut-out part and an
-/// invalid face for the others. `topology` and `points` (n × 3) are B's. Throws what remesh()
-/// and sub_mesh() (multires/face_patch.h) throw.
+/// invalid face for the others. `topology`, `points` (n × 3) and `base_length` (the mean edge
+/// length) are B's. Throws what remesh() and sub_mesh() (multires/face_patch.h) throw.
 RemeshResult make_coarse_base(const Mesh& base, const TriangleTopology& topology,
-                              const Eigen::MatrixXd& points, const std::vector<int>& free_vertices,
+                              const Eigen::MatrixXd& points, double base_length,
+                              const std::vector<int>& free_vertices,
                               const NonlinearOptions& options);
 /// Whether `coarse`, made by make_coarse_base() for some region, serves the free base vertices
 /// `free_vertices` as well: an edge length within 50 % of the one they call for, and every
 /// vertex within two coarse edge lengths of them located on it.
 bool coarse_base_serves(const RemeshResult& coarse, const Mesh& base,
-                        const TriangleTopology& topology, const std::vector<int>& free_vertices,
-                        const NonlinearOptions& options);
+                        const TriangleTopology& topology, double base_length,
+                        const std::vector<int>& free_vertices, const NonlinearOptions& options);
 /// The edge length make_coarse_base() aims at for `free_vertices` on a base of mean edge length
 /// `base_length`.
 double coarse_length(double base_length, std::size_t free_vertices,
