@@ -8,6 +8,7 @@
 #include <iostream>
 #include <numbers>
 #include <random>
+#include <stop_token>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -221,6 +222,74 @@ TEST(Nonlinear, TheNextRegionInTheSamePlaceKeepsTheCoarseBase) {
   EXPECT_TRUE(region(north, 0.8));
   EXPECT_FALSE(region(north, 0.83)); // kept
   EXPECT_TRUE(region(south, 0.8));   // elsewhere: cut out again
+}
+
+// A region's nonlinear state built apart (Editor::NonlinearBuild, as remora serve builds it after
+// showing the region): linear frames that have not converged meanwhile, then set_region's result;
+// a stopped build leaves it to the next frame; a build for a region since replaced goes to that
+// region, kept for an undo.
+TEST(Nonlinear, AStateBuiltApartGivesSetRegionsResult) {
+  const Mesh sphere = make_icosphere(4);
+  EditorOptions o = nonlinear_options();
+  o.remesh = false;
+  o.nonlinear.preview_vertices = 300;
+  const VertexHandle north = nearest_vertex(sphere, Vec3(0, 0, 1));
+  const std::vector<int> support = select_geodesic_disc(sphere, north, 1.2);
+  const std::vector<std::vector<int>> handles{select_geodesic_disc(sphere, north, 0.3)};
+  const Transform turn =
+      compose(translation(Eigen::Vector3d(0.2, 0, 0.3)), rotation({1, 0, 0}, 1.2, {0, 0, 1}));
+  Editor whole(sphere, o);
+  whole.set_region(support, handles);
+  whole.set_transform(0, turn);
+  const Eigen::MatrixXd expected = whole.positions();
+  EditorOptions lo = o;
+  lo.method = EditMethod::Linear;
+  Editor linear(sphere, lo);
+  linear.set_region(support, handles);
+  linear.set_transform(0, turn);
+  const Eigen::MatrixXd blend = linear.positions();
+  ASSERT_GT(max_row_distance(expected, blend), 0.05); // the methods differ here
+
+  Editor apart(sphere, o);
+  apart.install_region(apart.prepare_region(support, handles, {}, true));
+  Editor::NonlinearBuild build = apart.nonlinear_build();
+  ASSERT_FALSE(build.empty());
+  apart.set_transform(0, turn);
+  EXPECT_LT(max_row_distance(apart.positions(5.0), blend), 1e-12);
+  EXPECT_EQ(apart.report().nonlinear_level, "preparing");
+  EXPECT_FALSE(apart.converged());
+  build.run();
+  apart.finish_nonlinear(std::move(build));
+  EXPECT_TRUE(apart.nonlinear_build().empty()); // there now
+  EXPECT_GT(apart.report().milliseconds.count("nonlinear setup"), 0u);
+  EXPECT_LT(max_row_distance(apart.positions(), expected), 1e-9);
+  EXPECT_TRUE(apart.converged());
+
+  // Stopped: the next frame builds the state itself.
+  Editor stopped(sphere, o);
+  stopped.install_region(stopped.prepare_region(support, handles, {}, true));
+  build = stopped.nonlinear_build();
+  std::stop_source stop;
+  stop.request_stop();
+  build.run(stop.get_token());
+  stopped.finish_nonlinear(std::move(build));
+  stopped.set_transform(0, turn);
+  stopped.positions(5.0);
+  EXPECT_NE(stopped.report().nonlinear_level, "preparing");
+  EXPECT_LT(max_row_distance(stopped.positions(), expected), 1e-9);
+
+  // Replaced before it finished: the state goes to the kept region, which an undo reinstalls.
+  Editor replaced(sphere, o);
+  replaced.install_region(replaced.prepare_region(support, handles, {}, true));
+  build = replaced.nonlinear_build();
+  replaced.set_region(select_geodesic_disc(sphere, north, 0.9), handles);
+  build.run();
+  replaced.finish_nonlinear(std::move(build));
+  replaced.set_region(support, handles); // kept: reinstalled as it was
+  EXPECT_TRUE(replaced.report().region_reused);
+  EXPECT_TRUE(replaced.nonlinear_build().empty());
+  replaced.set_transform(0, turn);
+  EXPECT_LT(max_row_distance(replaced.positions(), expected), 1e-9);
 }
 
 TEST(Nonlinear, TheEnergyNeverIncreases) {

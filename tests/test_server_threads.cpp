@@ -292,6 +292,64 @@ TEST(ServerThreads, ARelaxStepGivesWayToARequestThatWaits) {
   EXPECT_EQ(gave_way, 1); // without the interrupt every step runs to convergence
 }
 
+/// The support of SphereRegion's sphere above z = `z`, its handle above z = 0.9.
+json region_above(const SphereRegion& r, double z) {
+  std::vector<int> support;
+  for (std::size_t v = 0; v < r.rest.size() / 3; ++v)
+    if (r.rest[3 * v + 2] > z) support.push_back(static_cast<int>(v));
+  return {{"support", support}, {"handles", {r.handle}}, {"method", "nonlinear"}};
+}
+
+// Method nonlinear: a new region is shown before its nonlinear state is built on the worker.
+// Meanwhile moves answer the linear frame, not converged, and a relax step waits for the state
+// at most its budget; once it is there a relax step converges; a new region stops a build and
+// follows it.
+TEST(ServerThreads, ANonlinearRegionIsShownWhileItsNonlinearStateIsBuilt) {
+  Gate gate("nonlinear state");
+  Session s(gate.options());
+  const SphereRegion r = load_sphere_with_region(s); // linear: nothing built apart
+  const std::vector<double> turn{1, 0, 0, 0, 0, 0, -1, 0.2, 0, 1, 0, 0.5};
+  gate.arm();
+  ASSERT_EQ(call(s, "POST", "/api/region", region_above(r, 0.0).dump()).status, 202);
+  gate.wait_reached(); // the worker builds the state
+  json st = status_of(s);
+  EXPECT_EQ(st["state"], "ready");
+  EXPECT_EQ(st["region"]["method"], "nonlinear");
+  EXPECT_TRUE(st["nonlinear"]["preparing"].get<bool>());
+  const HttpResponse moved = move(s, turn);
+  ASSERT_EQ(moved.status, 200) << moved.body;
+  EXPECT_EQ(moved.headers.at("X-Converged"), "0");
+  const HttpResponse waited = call(s, "POST", "/api/relax", R"({"budget_ms": 30})");
+  ASSERT_EQ(waited.status, 200) << waited.body;
+  EXPECT_EQ(waited.headers.at("X-Converged"), "0");
+  EXPECT_EQ(waited.body, moved.body); // still the linear frame
+  gate.release();
+  const HttpResponse relaxed = call(s, "POST", "/api/relax", R"({"budget_ms": 10000})");
+  ASSERT_EQ(relaxed.status, 200) << relaxed.body;
+  EXPECT_EQ(relaxed.headers.at("X-Converged"), "1");
+  EXPECT_NE(relaxed.body, moved.body); // the nonlinear shape
+  st = status_of(s);
+  EXPECT_FALSE(st["nonlinear"]["preparing"].get<bool>());
+  EXPECT_GT(st["nonlinear"]["iterations"].get<int>(), 0);
+
+  // A new region while a build runs: the build stops and the region follows.
+  gate.arm();
+  ASSERT_EQ(call(s, "POST", "/api/region", region_above(r, 0.1).dump()).status, 202);
+  gate.wait_reached();
+  const json last = region_above(r, -0.2);
+  ASSERT_EQ(call(s, "POST", "/api/region", last.dump()).status, 202);
+  EXPECT_EQ(status_of(s)["state"], "busy");
+  gate.release();
+  s.wait();
+  st = status_of(s);
+  EXPECT_FALSE(st.contains("error")) << st;
+  EXPECT_EQ(st["region"]["support"], last["support"].size());
+  ASSERT_EQ(move(s, turn).status, 200);
+  const HttpResponse end = call(s, "POST", "/api/relax", R"({"budget_ms": 10000})");
+  ASSERT_EQ(end.status, 200) << end.body;
+  EXPECT_EQ(end.headers.at("X-Converged"), "1");
+}
+
 /// Connects to the loopback port, sends `bytes`, reads at most `keep` bytes of the answer and
 /// hangs up (with a reset when `reset`).
 void send_and_hang_up(int port, const std::string& bytes, std::size_t keep, bool reset) {

@@ -64,7 +64,8 @@ export function showStats(s, frameMs) {
     lines.push(`support ${s.region.support.toLocaleString()}, ${s.region.handles} handle(s), k = ${s.region.k}, ${s.region.method ?? 'linear'}`);
     lines.push(`set_region ${s.region.set_region_ms.toFixed(0)} ms, frame ${(frameMs ?? s.frame_ms ?? 0).toFixed(1)} ms`);
     const n = s.nonlinear;
-    if (n) lines.push(n.fallback ? 'nonlinear: fell back to linear' : `nonlinear: ${n.converged ? 'converged' : 'iterating'}, ${n.iterations} iterations`);
+    if (n) lines.push(n.fallback ? 'nonlinear: fell back to linear' : n.preparing ? 'nonlinear: preparing (linear until then)'
+      : `nonlinear: ${n.converged ? 'converged' : 'iterating'}, ${n.iterations} iterations`);
   }
   $('stats').textContent = lines.join('\n');
   setBusy(s.state === 'busy', s);

@@ -100,12 +100,13 @@ Session::Session(SessionOptions options) : impl_(std::make_unique<Impl>()) {
 }
 
 Session::~Session() {
+  impl_->stop.request_stop(); // a region's nonlinear build ends early (a job does not stop)
   if (impl_->worker.joinable()) impl_->worker.join();
 }
 
 void Session::wait() {
   auto lock = impl_->acquire();
-  impl_->idle.wait(lock, [&] { return !impl_->busy; });
+  impl_->idle.wait(lock, [&] { return !impl_->busy && !impl_->finishing; });
 }
 
 std::size_t Session::vertex_count() const {
@@ -138,6 +139,13 @@ Frame Session::relax(double budget_ms, FrameAnswer answer) {
   if (!(budget_ms > 0.0) || !(budget_ms <= 10000.0))
     throw InvalidArgument("budget_ms: expected milliseconds above 0, at most 10000");
   if (answer == FrameAnswer::None) throw InvalidArgument("a relax step answers something");
+  const auto t0 = Clock::now();
+  if (m.finishing) { // the region's nonlinear state first, within the budget
+    m.idle.wait_for(lock, std::chrono::duration<double, std::milli>(budget_ms),
+                    [&m] { return !m.finishing; });
+    m.require_region(); // a job may have begun meanwhile
+    budget_ms = std::max(1.0, budget_ms - ms_since(t0));
+  }
   return m.frame(budget_ms, answer, [&m] { return m.waiting > 0; }); // another request first
 }
 
@@ -224,6 +232,7 @@ nlohmann::json Session::status() const {
     if (m.region->method == EditMethod::Nonlinear)
       j["nonlinear"] = {{"iterations", r.nonlinear.total_iterations},
                         {"converged", m.box->editor.converged()},
+                        {"preparing", m.finishing},
                         {"fallback", r.fallback}};
   }
   return j;
@@ -255,6 +264,7 @@ std::vector<float> to_floats(const Eigen::MatrixXd& p) {
 
 std::vector<float> Session::positions() const {
   auto lock = impl_->acquire();
+  impl_->await_nonlinear(lock);
   const Impl& m = *impl_;
   m.require_ready();
   Editor& editor = m.box->editor;
@@ -294,6 +304,7 @@ FrameExport Session::frame_export() const {
 
 std::vector<float> Session::base_positions() const {
   auto lock = impl_->acquire();
+  impl_->await_nonlinear(lock);
   const Impl& m = *impl_;
   m.require_ready();
   Editor& editor = m.box->editor;
@@ -338,6 +349,7 @@ std::string Session::export_mesh(const std::string& format) const {
   Mesh result;
   {
     auto lock = impl_->acquire();
+    impl_->await_nonlinear(lock);
     impl_->require_ready();
     result = impl_->region ? impl_->box->editor.result() : impl_->box->editor.input();
   }

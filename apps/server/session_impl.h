@@ -63,9 +63,16 @@ struct Session::Impl {
     --waiting;
     return lock;
   }
-  std::condition_variable idle;
+  std::condition_variable idle; // a job ended, or the region's nonlinear state is there
   std::thread worker;
   bool busy = false;
+  /// The worker builds the new region's nonlinear state after showing the region
+  /// (Editor::NonlinearBuild): frames go on, linear until it is there.
+  bool finishing = false;
+  /// Waits, the lock released, until the worker has finished the region's nonlinear state.
+  void await_nonlinear(std::unique_lock<std::mutex>& lock) {
+    idle.wait(lock, [&] { return !finishing; });
+  }
   // The running job's stop request, and the job queued behind it (a new region stops a region job).
   std::stop_source stop;
   std::function<void(std::stop_token)> pending;
@@ -114,7 +121,8 @@ struct Session::Impl {
   /// preprocessing shares. Call under the lock.
   void report(std::string_view p, int s, int n);
   /// Runs `work` on the worker. A region job while one runs stops it and is queued behind it
-  /// (replacing one queued already); any other overlap throws Busy. Call under the lock.
+  /// (replacing one queued already); so is any job while the worker finishes a region's
+  /// nonlinear state; any other overlap throws Busy. Call under the lock.
   void run(std::string what, std::function<void(std::stop_token)> work);
   /// A job's start: a fresh stop request, no progress, no error. Call under the lock.
   void begin_job();
@@ -127,7 +135,9 @@ struct Session::Impl {
   struct RegionWork {
     bool bake, resolve, new_region;
   };
-  /// A region job: the bake, the region prepared, then installed unless a newer region stopped it.
+  /// A region job: the bake, the region prepared, then installed unless a newer region stopped
+  /// it; method nonlinear's state of a new region is built after the install, the job no
+  /// longer busy (`finishing`).
   void region_job(const RegionKey& key, RegionWork work, const std::shared_ptr<EditorBox>& current,
                   const std::vector<Transform>& moved_by, const std::stop_token& token);
   /// positions(budget) of the editor, as the answer to a move or a relax step. Under the lock.

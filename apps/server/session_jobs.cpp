@@ -52,6 +52,17 @@ void Session::Impl::report(std::string_view p, int s, int n) {
 /// Runs `work` on the worker. A region job while one runs stops it and is queued behind it
 /// (replacing one queued already); any other overlap throws Busy. Call under the lock.
 void Session::Impl::run(std::string what, std::function<void(std::stop_token)> work) {
+  if (finishing && !busy) { // the nonlinear build stops; this job follows it
+    stop.request_stop();
+    pending = std::move(work);
+    busy = true;
+    job = std::move(what);
+    phase = "starting";
+    step = steps = 0;
+    fraction = 0.0;
+    error.clear();
+    return;
+  }
   if (busy) {
     if (what == "region" && job == "region") {
       stop.request_stop();
@@ -75,6 +86,9 @@ void Session::Impl::run(std::string what, std::function<void(std::stop_token)> w
         error = e.what();
       }
       auto lock = acquire();
+      // Ended here, not in the job: run() may join the worker once nothing is finishing.
+      finishing = false;
+      idle.notify_all();
       if (pending) {
         work = std::move(pending);
         pending = nullptr;
@@ -150,7 +164,8 @@ void Session::Impl::region_job(const RegionKey& key, RegionWork work,
     if (!token.stop_requested()) editor.prepare_regions(); // a new k (the load job: the first)
     editor.set_method(key.method);
     editor.set_nonlinear_energy(key.energy);
-    if (work.new_region) prepared = editor.prepare_region(key.support, key.handles, token);
+    if (work.new_region)
+      prepared = editor.prepare_region(key.support, key.handles, token, !work.resolve);
   } catch (...) {
     restore();
     throw;
@@ -160,7 +175,12 @@ void Session::Impl::region_job(const RegionKey& key, RegionWork work,
     restore();
     return;
   }
-  if (prepared) editor.install_region(std::move(*prepared));
+  // Method nonlinear: a new region is shown first, its nonlinear state built after.
+  Editor::NonlinearBuild build;
+  if (prepared) {
+    editor.install_region(std::move(*prepared));
+    if (!work.resolve) build = editor.nonlinear_build();
+  }
   next->region = key;
   box = next;
   region = key;
@@ -178,18 +198,33 @@ void Session::Impl::region_job(const RegionKey& key, RegionWork work,
     // A move that went unanswered: the shape shows the new base (the baked move) in full,
     // not only around the new region's movable vertices.
     if (shape_behind) {
-      shape->set_positions(box->editor.positions());
+      shape->set_positions(build.empty() ? box->editor.positions()
+                                         : box->editor.positions(options.frame_budget_ms));
       shape_behind = false;
     }
   }
   push_snapshot();
+  if (build.empty()) return;
+  // The region is shown (no longer busy); its nonlinear state is built without the lock.
+  finishing = true;
+  busy = false;
+  phase.clear();
+  idle.notify_all();
+  lock.unlock();
+  try {
+    build.run(token);
+  } catch (const std::exception&) {
+    // Not built: the region's next frame builds it, and reports what fails.
+  }
+  lock = acquire();
+  editor.finish_nonlinear(std::move(build)); // `finishing` ends as the worker's job ends
 }
 
 /// report() under the lock, then the options' own progress callback without it. On the worker.
 void Session::Impl::progress(std::string_view p, int s, int n) {
   {
     auto lock = acquire();
-    report(p, s, n);
+    if (!finishing) report(p, s, n); // a finishing build is no job's progress
   }
   if (options.editor.progress) options.editor.progress(p, s, n);
 }

@@ -289,9 +289,19 @@ const Transform& Editor::transform(int handle) const {
 // nonlinear state replaces its free rows, or leaves the blend with a message.
 void Editor::Impl::deform_base(RegionState& r, bool moved, double budget_ms,
                                const std::function<bool()>& interrupt) {
-  if (!r.nonlinear || r.nonlinear_energy != options.nonlinear.energy) { // after set_method()
+  if (needs_nonlinear(r) && r.nonlinear_deferred && std::isfinite(budget_ms)) {
+    report.method = "nonlinear"; // built apart (NonlinearBuild): the blend stands meanwhile
+    report.nonlinear_energy = to_string(options.nonlinear.energy);
+    report.nonlinear = NonlinearStats{};
+    report.nonlinear_level = "preparing";
+    report.fallback.clear();
+    report.milliseconds["frame nonlinear"] = 0.0;
+    return;
+  }
+  if (needs_nonlinear(r)) { // after set_method(), or a build apart that did not finish
     build_nonlinear(r, report);
     if (r.coarse) coarse = r.coarse;
+    moved = true; // the new state has not seen the transforms
   }
   const auto t0 = Clock::now();
   RowPoints positions = r.frame.leftCols<3>();
@@ -354,7 +364,7 @@ const Eigen::MatrixXd& Editor::positions(double budget_ms, const std::function<b
 bool Editor::converged() const {
   const RegionState* r = impl_->region.get();
   if (!r || impl_->options.method == EditMethod::Linear) return true;
-  return !r->dirty && r->nonlinear && r->nonlinear->finished();
+  return !r->dirty && !impl_->needs_nonlinear(*r) && r->nonlinear->finished();
 }
 
 Mesh Editor::result() {

@@ -145,7 +145,8 @@ struct EditReport {
   /// Method nonlinear: its energy's name (to_string(NonlinearEnergy)).
   std::string nonlinear_energy;
   /// Method nonlinear: "coarse" when the last frame showed the preview of a large support,
-  /// "fine" otherwise (multires/nonlinear_region.h).
+  /// "fine" otherwise (multires/nonlinear_region.h), "preparing" while its state is built apart
+  /// (Editor::NonlinearBuild: the frame is linear).
   std::string nonlinear_level;
   /// Method nonlinear: why the last frame shows the linear result instead (empty otherwise).
   std::string fallback;
@@ -262,10 +263,46 @@ public:
     friend class Editor;
     std::unique_ptr<State> state_;
   };
+  /// `defer_nonlinear`: method nonlinear's state is left out of the region (NonlinearBuild).
   Prepared prepare_region(const std::vector<int>& support,
                           const std::vector<std::vector<int>>& handles,
-                          const std::stop_token& stop = {});
+                          const std::stop_token& stop = {}, bool defer_nonlinear = false);
   void install_region(Prepared&& prepared);
+
+  /// Method nonlinear's state of the current region (its deformers, factored, and the coarse
+  /// level of its preview), built apart from set_region, so that a server shows the region
+  /// before that state is ready:
+  /// - nonlinear_build(), under the caller's lock, captures what the build reads and marks the
+  ///   region deferred;
+  /// - NonlinearBuild::run() builds it from that capture and from the editor's preprocessed
+  ///   parts, which nothing changes, so the caller's lock can be released meanwhile;
+  /// - finish_nonlinear(), under the lock, gives it to the region it was captured from, the
+  ///   current one or one kept for an undo, unless that region has one by then, and ends the
+  ///   deferral whether or not the build ran.
+  /// While a region is deferred, positions(budget) leave the linear result (report()'s
+  /// nonlinear_level "preparing", converged() false), and positions() without a budget builds
+  /// the state itself. The build is empty (run() and finish_nonlinear() do nothing) when the
+  /// region needs none: method linear, no region, or its state is there. The editor must outlive
+  /// its builds.
+  class NonlinearBuild {
+  public:
+    NonlinearBuild();
+    NonlinearBuild(NonlinearBuild&&) noexcept;
+    NonlinearBuild& operator=(NonlinearBuild&&) noexcept;
+    ~NonlinearBuild();
+    bool empty() const;
+    /// Builds, unless `stop` is triggered first (checked before each factorization: the
+    /// region's next frame then builds it). Throws what set_region's nonlinear step throws.
+    void run(const std::stop_token& stop = {});
+    struct State;
+
+  private:
+    friend class Editor;
+    std::unique_ptr<State> state_;
+  };
+  /// `threads`: the build's (0: the editor's).
+  NonlinearBuild nonlinear_build(int threads = 0);
+  void finish_nonlinear(NonlinearBuild&& build);
 
   int handle_count() const;
   /// The vertices of O that can move under the current region (the support, handles included),

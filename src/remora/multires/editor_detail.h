@@ -16,6 +16,7 @@
 
 #include <Eigen/Core>
 
+#include "remora/common/error.h"
 #include "remora/geometry/measures.h"
 #include "remora/multires/editor.h"
 #include "remora/multires/frame.h"
@@ -54,7 +55,9 @@ struct Editor::Prepared::State {
   std::unique_ptr<NonlinearRegion> nonlinear; // method nonlinear (multires/nonlinear_region.h)
   NonlinearEnergy nonlinear_energy{};         // what `nonlinear` was built for
   std::shared_ptr<const RemeshResult> coarse; // its preview level (kept by the editor)
-  std::uint64_t bytes = 0; // its estimated memory (region_bytes() of multires/limits.h)
+  std::uint64_t serial = 0;        // which prepare_region() made it, for finish_nonlinear()
+  bool nonlinear_deferred = false; // its nonlinear state is built apart (NonlinearBuild)
+  std::uint64_t bytes = 0;         // its estimated memory (region_bytes() of multires/limits.h)
 };
 
 using RegionState = Editor::Prepared::State;
@@ -97,7 +100,16 @@ struct Editor::Impl : EditorParts {
     return *region;
   }
   void update(double budget_ms, const std::function<bool()>& interrupt = {});
+  std::uint64_t regions_prepared = 0; // the serial of the last prepare_region()
   void build_nonlinear(RegionState& r, EditReport& into);
+  /// What building r's nonlinear state reads, copied (Editor::NonlinearBuild).
+  std::unique_ptr<Editor::NonlinearBuild::State> capture_nonlinear(const RegionState& r);
+  /// The built state into r; its times into `into`.
+  void adopt_nonlinear(RegionState& r, Editor::NonlinearBuild::State& built, EditReport& into);
+  /// r's nonlinear state is missing or for another energy.
+  bool needs_nonlinear(const RegionState& r) const {
+    return !r.nonlinear || r.nonlinear_energy != options.nonlinear.energy;
+  }
   void deform_base(RegionState& r, bool moved, double budget_ms,
                    const std::function<bool()>& interrupt);
 

@@ -333,46 +333,6 @@ void Editor::Impl::find_affected(RegionState& r) const {
   r.affected = plan_normals(topology, vertices);
 }
 
-// Method nonlinear: its deformers from B0, the labels and the handles' scalar weights (the basis
-// functions' "1" columns); for a large support the coarse base of its preview, a remesh of the
-// support's part of the base, kept while later regions lie in it and call for about the same
-// coarse edge length.
-void Editor::Impl::build_nonlinear(RegionState& r, EditReport& into) {
-  const auto t0 = Clock::now();
-  Eigen::MatrixXd weights = Eigen::MatrixXd::Zero(r.rest.rows(), r.handles);
-  for (std::size_t row = 0; row < r.free_vertices.size(); ++row)
-    for (int j = 0; j < r.handles; ++j)
-      weights(r.free_vertices[row], j) =
-          static_cast<double>(r.basis(static_cast<Eigen::Index>(row), 3 + 4 * j + 3));
-  for (int j = 0; j < r.handles; ++j)
-    for (const int v : r.handle_base[static_cast<std::size_t>(j)]) weights(v, j) = 1.0;
-  NonlinearOptions o = options.nonlinear;
-  o.threads = options.threads;
-  const std::size_t n_free = r.free_vertices.size();
-  // Propagated rotations take one solve per frame, blended motions none: no preview.
-  const bool preview = o.energy != NonlinearEnergy::PropagatedRotations &&
-                       o.energy != NonlinearEnergy::BlendedMotions && o.preview_vertices > 0 &&
-                       n_free > 2 * static_cast<std::size_t>(o.preview_vertices);
-  if (preview) {
-    const double length = mean_base_length();
-    r.coarse = coarse;
-    if (!r.coarse || !coarse_base_serves(*r.coarse, base, topology, length, r.free_vertices, o)) {
-      const auto t1 = Clock::now();
-      try {
-        r.coarse = std::make_shared<const RemeshResult>(
-            make_coarse_base(base, topology, base_rest, length, r.free_vertices, o));
-      } catch (const Error&) { // no preview: the fine level alone, which works
-        r.coarse.reset();
-      }
-      into.milliseconds["nonlinear coarse base"] = ms_since(t1);
-    }
-  }
-  r.nonlinear_energy = o.energy;
-  r.nonlinear = std::make_unique<NonlinearRegion>(base, preview ? r.coarse.get() : nullptr, r.rest,
-                                                  r.base_label, weights, o);
-  into.milliseconds["nonlinear setup"] = ms_since(t0);
-}
-
 // Sets r.bytes; throws InvalidArgument when the region and the preprocessing exceed the limit.
 void Editor::Impl::bytes_for(RegionState& r) const {
   const auto free_vertices =
@@ -407,7 +367,7 @@ Editor::Prepared::~Prepared() = default;
 
 Editor::Prepared Editor::prepare_region(const std::vector<int>& support,
                                         const std::vector<std::vector<int>>& handles,
-                                        const std::stop_token& stop) {
+                                        const std::stop_token& stop, bool defer_nonlinear) {
   Impl& m = *impl_;
   const auto t_start = Clock::now();
   const auto check = [&] {
@@ -433,6 +393,7 @@ Editor::Prepared Editor::prepare_region(const std::vector<int>& support,
   std::unique_ptr<RegionState> state = m.paint(support, handles);
   RegionState& r = *state;
   r.owner = impl_.get();
+  r.serial = ++m.regions_prepared;
   r.support = support;
   r.handle_ids = handles;
   r.system = m.options.system;
@@ -453,7 +414,7 @@ Editor::Prepared Editor::prepare_region(const std::vector<int>& support,
   double finish_ms = ms_since(t_finish);
   m.encode_details(r, r.report, stop);
   check();
-  if (m.options.method == EditMethod::Nonlinear) m.build_nonlinear(r, r.report);
+  if (m.options.method == EditMethod::Nonlinear && !defer_nonlinear) m.build_nonlinear(r, r.report);
   t_finish = Clock::now();
   r.transforms.assign(static_cast<std::size_t>(r.handles), identity_transform());
   r.frame = frame_rows(r.rest, r.rest_normals);
