@@ -110,9 +110,10 @@ try {
   const support = regionStatus.support ?? 0;
   const setRegion = regionStatus.set_region_ms ?? null;
   const setRegionParts = regionStatus.set_region_parts_ms ?? null;
+  const pageOrigin = await page.evaluate(() => performance.timeOrigin); // the page's clock, from here
   const nonlinearBuilt = (async () => { // the status polled every 10 ms from the manipulator on
     while ((await json('status')).nonlinear?.preparing) await new Promise((r) => setTimeout(r, 10));
-    return page.evaluate(() => performance.now());
+    return Date.now() - pageOrigin;
   })();
 
   // Drags of the manipulator's arrow, the mesh shown, then hidden.
