@@ -100,7 +100,10 @@ Session::Session(SessionOptions options) : impl_(std::make_unique<Impl>()) {
 }
 
 Session::~Session() {
-  impl_->stop.request_stop(); // a region's nonlinear build ends early (a job does not stop)
+  {
+    auto lock = impl_->acquire();
+    impl_->stop.request_stop(); // a region's nonlinear build ends early
+  }
   if (impl_->worker.joinable()) impl_->worker.join();
 }
 
