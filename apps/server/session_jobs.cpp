@@ -50,7 +50,8 @@ void Session::Impl::report(std::string_view p, int s, int n) {
 }
 
 /// Runs `work` on the worker. A region job while one runs stops it and is queued behind it
-/// (replacing one queued already); any other overlap throws Busy. Call under the lock.
+/// (replacing one queued already); so is any job while the worker finishes a region's
+/// nonlinear state; any other overlap throws Busy. Call under the lock.
 void Session::Impl::run(std::string what, std::function<void(std::stop_token)> work) {
   if (finishing && !busy) { // the nonlinear build stops; this job follows it
     stop.request_stop();

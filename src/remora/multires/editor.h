@@ -300,8 +300,7 @@ public:
     friend class Editor;
     std::unique_ptr<State> state_;
   };
-  /// `threads`: the build's (0: the editor's).
-  NonlinearBuild nonlinear_build(int threads = 0);
+  NonlinearBuild nonlinear_build();
   void finish_nonlinear(NonlinearBuild&& build);
 
   int handle_count() const;

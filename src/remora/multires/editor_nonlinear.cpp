@@ -111,7 +111,7 @@ bool Editor::NonlinearBuild::empty() const {
   return !state_;
 }
 
-Editor::NonlinearBuild Editor::nonlinear_build(int threads) {
+Editor::NonlinearBuild Editor::nonlinear_build() {
   Impl& m = *impl_;
   NonlinearBuild build;
   if (!m.region || m.options.method != EditMethod::Nonlinear || !m.needs_nonlinear(*m.region))
@@ -119,7 +119,6 @@ Editor::NonlinearBuild Editor::nonlinear_build(int threads) {
   m.region->nonlinear_deferred = true;
   build.state_ = m.capture_nonlinear(*m.region);
   build.state_->apart = true;
-  if (threads > 0) build.state_->options.threads = threads;
   return build;
 }
 
