@@ -126,6 +126,7 @@ struct Session::Impl {
   void run(std::string what, std::function<void(std::stop_token)> work);
   /// A job's start: a fresh stop request, no progress, no error. Call under the lock.
   void begin_job();
+  void reset_progress(); ///< begin_job()'s part but the stop request
   /// The editor that `current` under `moved_by` bakes into (the edited shape as a new input), or
   /// the one a stopped job made for the same bake.
   std::shared_ptr<EditorBox> bake_once(const std::shared_ptr<EditorBox>& current,

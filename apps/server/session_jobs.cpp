@@ -58,10 +58,7 @@ void Session::Impl::run(std::string what, std::function<void(std::stop_token)> w
     pending = std::move(work);
     busy = true;
     job = std::move(what);
-    phase = "starting";
-    step = steps = 0;
-    fraction = 0.0;
-    error.clear();
+    reset_progress();
     return;
   }
   if (busy) {
@@ -108,6 +105,11 @@ void Session::Impl::run(std::string what, std::function<void(std::stop_token)> w
 /// A job's start: a fresh stop request, no progress, no error. Call under the lock.
 void Session::Impl::begin_job() {
   stop = std::stop_source();
+  reset_progress();
+}
+
+/// No progress and no error yet. Call under the lock.
+void Session::Impl::reset_progress() {
   phase = "starting";
   step = steps = 0;
   fraction = 0.0;
