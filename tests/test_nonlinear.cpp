@@ -614,6 +614,56 @@ TEST(NonlinearDeformer, BestRotationMatchesTheSvdAndNeverLosesToItsStart) {
   EXPECT_GT(close, 385); // a few nearly degenerate draws need more than one call
 }
 
+// Newton's steps from a warm start (the start near the optimum, as in an iteration's later local
+// steps) end at the SVD's optimum to round-off. From another critical point (the optimum turned
+// half a turn about an axis of P's SVD: P R symmetric, H not positive definite) or with a
+// degenerate P they give way to the power iteration, whose result is no worse than the start.
+TEST(NonlinearDeformer, BestRotationFromAWarmStartIsTheSvdsOptimum) {
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int trial = 0; trial < 300; ++trial) {
+    Eigen::Matrix3d p;
+    for (int i = 0; i < 9; ++i) p(i / 3, i % 3) = u(rng);
+    if (trial % 3 == 2) p = p.col(0) * p.row(1).eval(); // rank 1: no unique optimum
+    const Eigen::JacobiSVD<Eigen::Matrix3d> svd(p, Eigen::ComputeFullU | Eigen::ComputeFullV);
+    Eigen::Matrix3d v = svd.matrixV();
+    if ((v * svd.matrixU().transpose()).determinant() < 0) v.col(2) = -v.col(2);
+    const Eigen::Matrix3d optimum = v * svd.matrixU().transpose();
+    const double best = (optimum * p).trace();
+    const double angle = trial % 2 ? 1e-3 : 0.2;
+    const Eigen::Matrix3d near =
+        optimum *
+        Eigen::AngleAxisd(angle * u(rng), Eigen::Vector3d(u(rng), u(rng), u(rng)).normalized())
+            .toRotationMatrix();
+    const Eigen::Matrix3d saddle = optimum * svd.matrixU() *
+                                   Eigen::Vector3d(-1.0, -1.0, 1.0).asDiagonal() *
+                                   svd.matrixU().transpose();
+    const std::array<Eigen::Matrix3d, 3> starts{near, saddle, optimum};
+    for (std::size_t which = 0; which < starts.size(); ++which) {
+      const Eigen::Matrix3d& start = starts[which];
+      const Eigen::Matrix3d r = best_rotation(p, start);
+      EXPECT_NEAR((r.transpose() * r - Eigen::Matrix3d::Identity()).norm(), 0.0, 1e-12);
+      EXPECT_NEAR(r.determinant(), 1.0, 1e-12);
+      EXPECT_GE((r * p).trace(), (start * p).trace() - 1e-12);
+      if (trial % 3 != 2 && which != 1) {
+        EXPECT_NEAR((r * p).trace(), best, 1e-12 * (1.0 + best)) << "start " << which;
+      }
+    }
+    if (trial % 3 != 2) { // Newton alone, where it is sure: the optimum itself
+      Eigen::Matrix3d r = near;
+      const bool settled = rotation_detail::newton_rotation(p, r);
+      if (angle < 0.01) {
+        EXPECT_TRUE(settled);
+      }
+      if (settled) {
+        EXPECT_NEAR((r - optimum).norm(), 0.0, 1e-10 / svd.singularValues()[2]);
+      }
+      Eigen::Matrix3d s = saddle;
+      EXPECT_FALSE(rotation_detail::newton_rotation(p, s));
+    }
+  }
+}
+
 TEST(NonlinearDeformer, RefusesMismatchedInput) {
   const Mesh m = make_cylinder(4, 8, 1.0, 1.0);
   const Eigen::MatrixXd rest = positions_matrix(m);

@@ -1,5 +1,5 @@
-// The local step of the nonlinear method's iterations (multires/nonlinear.h): the best rotation
-// of a vertex's cell, Horn's quaternion power iteration with an SVD fallback.
+// The local step's rotation when Newton's method (best_rotation.h) does not settle: Horn's
+// quaternion power iteration with an SVD fallback.
 #include "remora/multires/best_rotation.h"
 
 #include <cmath>
@@ -35,7 +35,9 @@ Matrix3 best_rotation_svd(const Matrix3& p) {
 // (N + c I)^(2^k) q₀ is at least as good as the start q₀ and converges to the best: up to eight
 // squarings, fewer once q is an eigenvector to round-off (a warm start). One call reaches the best
 // unless N's two largest eigenvalues nearly coincide; the iteration's next local step goes on.
-Eigen::Matrix3d best_rotation(const Eigen::Matrix3d& p, const Eigen::Matrix3d& start) {
+namespace rotation_detail {
+
+Eigen::Matrix3d best_rotation_power(const Eigen::Matrix3d& p, const Eigen::Matrix3d& start) {
   const double sxx = p(0, 0), sxy = p(0, 1), sxz = p(0, 2), syx = p(1, 0), syy = p(1, 1),
                syz = p(1, 2), szx = p(2, 0), szy = p(2, 1), szz = p(2, 2);
   Eigen::Matrix4d n;
@@ -65,5 +67,7 @@ Eigen::Matrix3d best_rotation(const Eigen::Matrix3d& p, const Eigen::Matrix3d& s
   }
   return Eigen::Quaterniond(q[0], q[1], q[2], q[3]).toRotationMatrix();
 }
+
+} // namespace rotation_detail
 
 } // namespace remora

@@ -134,13 +134,21 @@ struct NonlinearDeformer::Impl {
     parallel_for(cells.size(), options.threads, [&](std::size_t c) {
       const int m = cells[c];
       const Matrix3& s = stretch[c];
-      Matrix3 p = Matrix3::Zero();
-      Vector3 r, d;
+      // P = a d rᵀ + Σ β w e⁰ eᵀ, accumulated in scalars: Eigen's 3 × 3 outer products wrote
+      // stack temporaries in halves and read them back whole, a store-forwarding stall each.
+      std::array<double, 9> p{};
+      const auto add_outer = [&p](double weight, const Vector3& u, const Vector3& v) {
+        for (int i = 0; i < 3; ++i) {
+          const double wu = weight * u[i];
+          for (int j = 0; j < 3; ++j) p[static_cast<std::size_t>(3 * i + j)] += wu * v[j];
+        }
+      };
+      Vector3 r = Vector3::Zero(), d = Vector3::Zero();
       if (a > 0.0) {
         r = laplacian(x, c);
         d = stretched ? Vector3(s * delta.row(static_cast<Eigen::Index>(c)).transpose())
                       : Vector3(delta.row(static_cast<Eigen::Index>(c)).transpose());
-        p += a * d * r.transpose();
+        add_outer(a, d, r);
       }
       // The ring's current and rest edges, kept for the energy (a ring longer than the buffer
       // computes them again).
@@ -159,9 +167,10 @@ struct NonlinearDeformer::Impl {
           es[static_cast<std::size_t>(k - ring_begin[c])] = e;
           e0s[static_cast<std::size_t>(k - ring_begin[c])] = e0;
         }
-        p += (beta * ring_weight[static_cast<std::size_t>(k)]) * e0 * e.transpose();
+        add_outer(beta * ring_weight[static_cast<std::size_t>(k)], e0, e);
       }
-      const Matrix3 rot = best_rotation(p, rotation[c]);
+      const Matrix3 rot = best_rotation(
+          Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(p.data()), rotation[c]);
       out[c] = rot;
       double energy = 0.0;
       if (a > 0.0) energy += a * (r - rot * d).squaredNorm();
