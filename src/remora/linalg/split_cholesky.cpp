@@ -14,6 +14,7 @@
 #include <cholmod.h>
 
 #include "remora/linalg/cholmod_settings.h"
+#include "remora/linalg/supernodal_solve.h"
 
 extern "C" { // BLAS and LAPACK (OpenBLAS, whose kernels use the machine's vector width)
 void dtrmm_(const char* side, const char* uplo, const char* transa, const char* diag, const int* m,
@@ -74,11 +75,6 @@ std::uint64_t pattern_hash(const Sparse& a) {
   return h;
 }
 
-Eigen::Map<Eigen::MatrixXd> as_matrix(cholmod_dense* d) {
-  return {static_cast<double*>(d->x), static_cast<Eigen::Index>(d->nrow),
-          static_cast<Eigen::Index>(d->ncol)};
-}
-
 } // namespace
 
 // Named, not anonymous: SplitCholesky::Impl holds it (GCC's -Wsubobject-linkage in unity builds).
@@ -98,8 +94,10 @@ struct Half {
   // lss lssᵀ = K_SS − C_iᵀ A_i⁻¹ C_i until summed, as R Rᵀ (upper triangle) with R = J lss J,
   // J the reversal of the rows: (lss lssᵀ)(a, b) = (R Rᵀ)(s−1−a, s−1−b).
   Eigen::MatrixXd product;
-  Eigen::MatrixXd rhs, t; // a solve's bordered right-hand side, and lss × its tail
-  cholmod_dense *xa = nullptr, *xb = nullptr, *y = nullptr, *e = nullptr;
+  // A solve's bordered right-hand side in the factor's order, rows interleaved
+  // (supernodal_solve.h); t = lss × its tail.
+  std::vector<double> work;
+  Eigen::MatrixXd t;
 
   Half() {
     cholmod_start(&c);
@@ -107,7 +105,6 @@ struct Half {
   }
   ~Half() {
     cholmod_free_factor(&factor, &c);
-    for (cholmod_dense** d : {&xa, &xb, &y, &e}) cholmod_free_dense(d, &c);
     cholmod_finish(&c);
   }
   Half(const Half&) = delete;
@@ -186,34 +183,48 @@ struct Half {
     return true;
   }
 
-  void sweep(int system, cholmod_dense* in, cholmod_dense** out) {
-    if (!cholmod_solve2(system, factor, in, nullptr, out, nullptr, &y, &e, &c) || *out == nullptr)
-      throw NumericalError("cholmod: the solve failed (out of memory?)");
-  }
-
-  // Forward: xb = L⁻¹ P [b_i; 0]; t = lss × its trailing rows = −C_iᵀ A_i⁻¹ b_i.
+  // Forward: work = L⁻¹ P [b_i; 0]; t = lss × its trailing rows = −C_iᵀ A_i⁻¹ b_i.
   void forward(const Eigen::MatrixXd& b) {
-    rhs.setZero(size(), b.cols());
-    for (int l = 0; l < n; ++l) rhs.row(l) = b.row(rows[static_cast<std::size_t>(l)]);
-    cholmod_dense in = dense_view(rhs.data(), static_cast<std::size_t>(rhs.rows()),
-                                  static_cast<std::size_t>(rhs.cols()));
-    sweep(CHOLMOD_P, &in, &xa);
-    sweep(CHOLMOD_L, xa, &xb);
-    t = as_matrix(xb).bottomRows(separator_rows());
+    const auto columns = static_cast<std::size_t>(b.cols());
+    const auto* perm = static_cast<const int*>(factor->Perm);
+    work.assign(static_cast<std::size_t>(size()) * columns, 0.0);
+    for (int k = 0; k < size(); ++k) { // row k of the factor's order is local row perm[k]
+      const int l = perm[k];
+      if (l >= n) continue; // the separator's rows of [b_i; 0]
+      const int g = rows[static_cast<std::size_t>(l)];
+      for (std::size_t col = 0; col < columns; ++col)
+        work[static_cast<std::size_t>(k) * columns + col] = b(g, static_cast<Eigen::Index>(col));
+    }
+    supernodal_forward(*factor, work.data(), static_cast<int>(columns));
+    const int s = separator_rows();
+    t.resize(s, static_cast<Eigen::Index>(columns));
+    for (int r = 0; r < s; ++r)
+      for (std::size_t col = 0; col < columns; ++col)
+        t(r, static_cast<Eigen::Index>(col)) =
+            work[static_cast<std::size_t>(n + r) * columns + col];
     lower_times(lss, 'N', t.data(), static_cast<int>(t.cols()), static_cast<int>(t.rows()));
   }
 
   // Backward, with the separator's values xs (in separator order): the half's rows of x.
   void backward(const Eigen::MatrixXd& xs, Eigen::MatrixXd& x) {
     const int s = separator_rows();
+    const auto columns = static_cast<std::size_t>(xs.cols());
     Eigen::MatrixXd ordered(s, xs.cols());
     for (int a = 0; a < s; ++a) ordered.row(a) = xs.row(order[static_cast<std::size_t>(a)]);
     lower_times(lss, 'T', ordered.data(), static_cast<int>(ordered.cols()), s);
-    as_matrix(xb).bottomRows(s) = ordered;
-    sweep(CHOLMOD_Lt, xb, &xa);
-    sweep(CHOLMOD_Pt, xa, &xb);
-    const auto solved = as_matrix(xb);
-    for (int l = 0; l < n; ++l) x.row(rows[static_cast<std::size_t>(l)]) = solved.row(l);
+    for (int r = 0; r < s; ++r)
+      for (std::size_t col = 0; col < columns; ++col)
+        work[static_cast<std::size_t>(n + r) * columns + col] =
+            ordered(r, static_cast<Eigen::Index>(col));
+    supernodal_backward(*factor, work.data(), static_cast<int>(columns));
+    const auto* perm = static_cast<const int*>(factor->Perm);
+    for (int k = 0; k < size(); ++k) { // Pᵀ: local row perm[k] is row k of the factor's order
+      const int l = perm[k];
+      if (l >= n) continue;
+      const int g = rows[static_cast<std::size_t>(l)];
+      for (std::size_t col = 0; col < columns; ++col)
+        x(g, static_cast<Eigen::Index>(col)) = work[static_cast<std::size_t>(k) * columns + col];
+    }
   }
 };
 
