@@ -244,13 +244,8 @@ TEST(ServerThreads, ConcurrentDragsEndOnOneOfTheirTransforms) {
   EXPECT_EQ(as<float>(call(s, "GET", "/api/mesh/positions")), shown);
 }
 
-// A relax step with a long budget gives way to a request that waits for the session: it ends
-// after the iteration under way, and the next step goes on to convergence. Three clients poll
-// the status while a step runs; a step can still end first (a small region converges in a few
-// milliseconds, and a loaded machine may not run the clients meanwhile), so the edit is tried
-// again, under new transforms, until one step has given way.
-TEST(ServerThreads, ARelaxStepGivesWayToARequestThatWaits) {
-  Session s;
+/// The sphere of load_sphere_with_region() with its region set again under method nonlinear.
+void set_nonlinear_region(Session& s) {
   const SphereRegion r = load_sphere_with_region(s);
   ASSERT_EQ(
       call(s, "POST", "/api/region",
@@ -258,16 +253,28 @@ TEST(ServerThreads, ARelaxStepGivesWayToARequestThatWaits) {
           .status,
       202);
   s.wait();
+}
+
+/// The handle turned by `a` about z and lifted by 0.3, answered as `answer` asks.
+HttpResponse turn(Session& s, double a, const char* answer) {
+  const double c = std::cos(a), n = std::sin(a);
+  return call(
+      s, "POST", "/api/transform",
+      json{{"handle", 0}, {"matrix", {c, -n, 0, 0, n, c, 0, 0, 0, 0, 1, 0.3}}, {"answer", answer}}
+          .dump());
+}
+
+// A relax step with a long budget gives way to a request that waits for the session: it ends
+// after the iteration under way, and the next step goes on to convergence. Three clients poll
+// the status while a step runs; a step can still end first (a small region converges in a few
+// milliseconds, and a loaded machine may not run the clients meanwhile), so the edit is tried
+// again, under new transforms, until one step has given way.
+TEST(ServerThreads, ARelaxStepGivesWayToARequestThatWaits) {
+  Session s;
+  set_nonlinear_region(s);
   int gave_way = 0;
   for (int attempt = 0; attempt < 40 && gave_way == 0; ++attempt) {
-    const double a = 1.0 + 0.01 * attempt, c = std::cos(a), n = std::sin(a);
-    ASSERT_EQ(call(s, "POST", "/api/transform",
-                   json{{"handle", 0},
-                        {"matrix", {c, -n, 0, 0, n, c, 0, 0, 0, 0, 1, 0.3}},
-                        {"answer", "none"}}
-                       .dump())
-                  .status,
-              204);
+    ASSERT_EQ(turn(s, 1.0 + 0.01 * attempt, "none").status, 204);
     std::atomic<bool> done{false};
     std::atomic<int> wrong{0}, polling{0};
     std::vector<std::thread> pollers;
@@ -290,6 +297,45 @@ TEST(ServerThreads, ARelaxStepGivesWayToARequestThatWaits) {
     EXPECT_EQ(rest.headers.at("X-Converged"), "1");
   }
   EXPECT_EQ(gave_way, 1); // without the interrupt every step runs to convergence
+}
+
+// After a relax step that ends unconverged the session iterates on by itself, between requests:
+// the status turns converged with no further step, and the next step answers that shape.
+// A move meanwhile is answered (it waits for one iteration at most) and stops it: the iteration
+// under the move's transform stays where the move's frame left it until the next relax step.
+TEST(ServerThreads, AnUnconvergedRelaxStepLeavesTheSessionIterating) {
+  Session s;
+  set_nonlinear_region(s);
+  const auto converged = [&] {
+    return json::parse(call(s, "GET", "/api/status").body)["nonlinear"]["converged"].get<bool>();
+  };
+  ASSERT_EQ(turn(s, 1.2, "none").status, 204);
+  const HttpResponse step = call(s, "POST", "/api/relax", R"({"budget_ms": 0.001})");
+  ASSERT_EQ(step.status, 200) << step.body;
+  ASSERT_EQ(step.headers.at("X-Iterations"), "1"); // one iteration always runs
+  ASSERT_EQ(step.headers.at("X-Converged"), "0");
+  const auto t0 = std::chrono::steady_clock::now();
+  while (!converged() && std::chrono::steady_clock::now() - t0 < std::chrono::seconds(60))
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  ASSERT_TRUE(converged()); // no request iterated meanwhile: the status polls do not
+  const HttpResponse done = call(s, "POST", "/api/relax", R"({"budget_ms": 10000})");
+  EXPECT_EQ(done.headers.at("X-Converged"), "1");
+  const HttpResponse again = call(s, "POST", "/api/relax", R"({"budget_ms": 10000})");
+  EXPECT_EQ(as<float>(again), as<float>(done)); // nothing was left to iterate
+
+  // A move during the relaxer's iterations: answered, and the relaxer stops.
+  ASSERT_EQ(turn(s, 0.4, "none").status, 204);
+  ASSERT_EQ(call(s, "POST", "/api/relax", R"({"budget_ms": 0.001})").headers.at("X-Converged"),
+            "0");
+  const HttpResponse moved = turn(s, 0.5, "positions");
+  ASSERT_EQ(moved.status, 200) << moved.body;
+  if (moved.headers.at("X-Converged") == "0") {
+    const auto status = json::parse(call(s, "GET", "/api/status").body);
+    std::this_thread::sleep_for(std::chrono::milliseconds(200));
+    const auto later = json::parse(call(s, "GET", "/api/status").body);
+    EXPECT_EQ(later["nonlinear"]["iterations"], status["nonlinear"]["iterations"]);
+    EXPECT_FALSE(later["nonlinear"]["converged"].get<bool>());
+  }
 }
 
 /// The support of SphereRegion's sphere above z = `z`, its handle above z = 0.9.

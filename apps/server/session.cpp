@@ -1,6 +1,7 @@
 #include "session.h"
 
 #include <algorithm>
+#include <chrono>
 #include <utility>
 
 #include <fmt/format.h>
@@ -16,6 +17,9 @@
 namespace remora::server {
 
 namespace {
+
+/// The relaxer's budget per editor.positions() call: a bound, as a request ends the call first.
+constexpr double kRelaxerBudgetMs = 10000.0;
 
 /// The movable vertices' rows of `p` as interleaved Float32.
 std::vector<float> movable_floats(const Editor& editor, const Eigen::MatrixXd& p) {
@@ -59,6 +63,7 @@ void Session::Impl::push_snapshot() {
 
 /// Re-applies a snapshot (undo/redo): same editor, region and transforms, same positions.
 void Session::Impl::apply(const Snapshot& s) {
+  relax_on = false;
   if (s.box != box || s.region != region) ++region_id;
   box = s.box;
   region = s.region;
@@ -95,15 +100,40 @@ Frame Session::Impl::frame(double budget_ms, FrameAnswer answer,
   return f;
 }
 
+void Session::Impl::relax_loop() {
+  std::unique_lock lock(mutex);
+  while (!closing) {
+    if (!relax_on || busy || finishing || !region) {
+      relax_wake.wait(lock);
+      continue;
+    }
+    if (waiting > 0) { // a request first; the lock is free again within its handling
+      relax_wake.wait_for(lock, std::chrono::milliseconds(2));
+      continue;
+    }
+    Editor& editor = box->editor;
+    if (editor.converged()) {
+      relax_on = false;
+      continue;
+    }
+    editor.positions(kRelaxerBudgetMs, [this] { return waiting > 0 || closing; });
+    shape_behind = true; // a pick brings the shape up to date
+  }
+}
+
 Session::Session(SessionOptions options) : impl_(std::make_unique<Impl>()) {
   impl_->options = std::move(options);
+  impl_->relaxer = std::thread([m = impl_.get()] { m->relax_loop(); });
 }
 
 Session::~Session() {
+  impl_->closing = true;
   {
     auto lock = impl_->acquire();
     impl_->stop.request_stop(); // a region's nonlinear build ends early
+    impl_->relax_wake.notify_all();
   }
+  impl_->relaxer.join();
   if (impl_->worker.joinable()) impl_->worker.join();
 }
 
@@ -129,6 +159,7 @@ Frame Session::set_transform(int handle, const Transform& transform, FrameAnswer
   m.require_offsets(answer);
   m.box->editor.set_transform(handle, transform); // validates
   m.transforms[static_cast<std::size_t>(handle)] = transform;
+  m.relax_on = false; // the page relaxes again after its pause
   if (answer != FrameAnswer::None) return m.frame(m.options.frame_budget_ms, answer);
   m.shape_behind = true;
   return {}; // no positions, no frame time
@@ -149,7 +180,12 @@ Frame Session::relax(double budget_ms, FrameAnswer answer) {
     m.require_region(); // a job may have begun meanwhile
     budget_ms = std::max(1.0, budget_ms - ms_since(t0));
   }
-  return m.frame(budget_ms, answer, [&m] { return m.waiting > 0; }); // another request first
+  Frame f = m.frame(budget_ms, answer, [&m] { return m.waiting > 0; }); // another request first
+  if (!f.converged) { // the relaxer goes on while the answer travels and the next step comes
+    m.relax_on = true;
+    m.relax_wake.notify_one();
+  }
+  return f;
 }
 
 void Session::commit() {

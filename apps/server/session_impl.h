@@ -65,6 +65,17 @@ struct Session::Impl {
   }
   std::condition_variable idle; // a job ended, or the region's nonlinear state is there
   std::thread worker;
+  /// Method nonlinear: a relax step ended before the iteration converged, so the relaxer thread
+  /// iterates on between requests (relax_loop()) until it converges or something else changes
+  /// the shape (a move, an undo or redo, a job), which clears this.
+  bool relax_on = false;
+  std::condition_variable relax_wake; // relax_on set, or closing
+  std::atomic<bool> closing{false};   // the session is being destroyed
+  std::thread relaxer;
+  /// The relaxer's loop: under the lock (not acquire(): requests do not wait for it), one
+  /// editor.positions() call at a time, each ended by the first request that waits for the
+  /// lock; it looks again once that request has had it.
+  void relax_loop();
   bool busy = false;
   /// The worker builds the new region's nonlinear state after showing the region
   /// (Editor::NonlinearBuild): frames go on, linear until it is there.

@@ -53,6 +53,7 @@ void Session::Impl::report(std::string_view p, int s, int n) {
 /// (replacing one queued already); so is any job while the worker finishes a region's
 /// nonlinear state; any other overlap throws Busy. Call under the lock.
 void Session::Impl::run(std::string what, std::function<void(std::stop_token)> work) {
+  relax_on = false;
   if (finishing && !busy) { // the nonlinear build stops; this job follows it
     stop.request_stop();
     pending = std::move(work);
