@@ -134,6 +134,9 @@ void NonlinearRegion::frame(const std::vector<AffineMap>& transforms, bool moved
       level_ = "coarse";
       preview_->compose(linear_, base);
       if (!stats_.finished() || ms_since(t0) >= budget_ms || (interrupt && interrupt())) return;
+      // The handles moved in this frame: the preview is what it shows, and the fine level (one
+      // iteration of which costs several of the preview's) starts once they rest.
+      if (moved && std::isfinite(budget_ms)) return;
     }
     if (fine_stale_) { // start from the preview's result, or from the linear one
       if (preview_) preview_->compose(linear_, base);

@@ -59,8 +59,9 @@ public:
   ~NonlinearRegion();
 
   /// One frame: `base` (every base vertex) holds the linear result under `transforms`; its free
-  /// rows are replaced. `moved`: the transforms changed since the last frame. `interrupt`: as for
-  /// NonlinearDeformer::solve(), also between the levels.
+  /// rows are replaced. `moved`: the transforms changed since the last frame; with a preview and
+  /// a finite budget such a frame stops at the preview, and the fine level starts in a later one.
+  /// `interrupt`: as for NonlinearDeformer::solve(), also between the levels.
   void frame(const std::vector<AffineMap>& transforms, bool moved, double budget_ms,
              RowPoints& base, const std::function<bool()>& interrupt = {});
   /// Nothing left to iterate under the current transforms (or fallen back).
