@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <exception>
 #include <utility>
 
 #include <fmt/format.h>
@@ -116,7 +117,11 @@ void Session::Impl::relax_loop() {
       relax_on = false;
       continue;
     }
-    editor.positions(kRelaxerBudgetMs, [this] { return waiting > 0 || closing; });
+    try {
+      editor.positions(kRelaxerBudgetMs, [this] { return waiting > 0 || closing; });
+    } catch (const std::exception&) {
+      relax_on = false; // the next relax step meets the failure and reports it
+    }
     shape_behind = true; // a pick brings the shape up to date
   }
 }
