@@ -14,7 +14,7 @@ namespace {
 using Matrix3 = Eigen::Matrix3d;
 
 /// The rotation R maximizing tr(R P) by SVD (orthogonal Procrustes; Sorkine & Alexa 2007,
-/// Eq. 6): the fallback of best_rotation().
+/// Eq. 6): the power iteration's fallback.
 Matrix3 best_rotation_svd(const Matrix3& p) {
   const Eigen::JacobiSVD<Matrix3> svd(p, Eigen::ComputeFullU | Eigen::ComputeFullV);
   Matrix3 v = svd.matrixV();
@@ -28,6 +28,8 @@ Matrix3 best_rotation_svd(const Matrix3& p) {
 
 } // namespace
 
+namespace rotation_detail {
+
 // tr(R(q) P) = qᵀ N q for unit quaternions q (Horn 1987, §4 with P = Σ p qᵀ, rest times current):
 // the best rotation is the eigenvector of N's largest eigenvalue. N + c I with c >= ‖N‖₂ (c =
 // √3 ‖P‖_F bounds the nuclear norm of P, hence every |λ(N)|) is positive semi-definite, and the
@@ -35,8 +37,6 @@ Matrix3 best_rotation_svd(const Matrix3& p) {
 // (N + c I)^(2^k) q₀ is at least as good as the start q₀ and converges to the best: up to eight
 // squarings, fewer once q is an eigenvector to round-off (a warm start). One call reaches the best
 // unless N's two largest eigenvalues nearly coincide; the iteration's next local step goes on.
-namespace rotation_detail {
-
 Eigen::Matrix3d best_rotation_power(const Eigen::Matrix3d& p, const Eigen::Matrix3d& start) {
   const double sxx = p(0, 0), sxy = p(0, 1), sxz = p(0, 2), syx = p(1, 0), syy = p(1, 1),
                syz = p(1, 2), szx = p(2, 0), szy = p(2, 1), szz = p(2, 2);
