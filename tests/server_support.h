@@ -81,14 +81,18 @@ inline SphereRegion load_sphere_with_region(Session& s, int k = 2) {
   return r;
 }
 
-/// POST /api/transform of handle 0 with the rows of [M | t]; the response.
 /// GET /api/status, parsed.
 inline nlohmann::json status_of(Session& s) {
   return nlohmann::json::parse(call(s, "GET", "/api/status").body);
 }
 
-inline HttpResponse move(Session& s, const std::vector<double>& rows) {
-  return call(s, "POST", "/api/transform", nlohmann::json{{"handle", 0}, {"matrix", rows}}.dump());
+/// POST /api/transform of handle 0 with the rows of [M | t], answered as `answer` asks (the
+/// server's default without one); the response.
+inline HttpResponse move(Session& s, const std::vector<double>& rows,
+                         const char* answer = nullptr) {
+  nlohmann::json body{{"handle", 0}, {"matrix", rows}};
+  if (answer) body["answer"] = answer;
+  return call(s, "POST", "/api/transform", body.dump());
 }
 
 } // namespace remora::server::testing_server

@@ -258,10 +258,7 @@ void set_nonlinear_region(Session& s) {
 /// The handle turned by `a` about z and lifted by 0.3, answered as `answer` asks.
 HttpResponse turn(Session& s, double a, const char* answer) {
   const double c = std::cos(a), n = std::sin(a);
-  return call(
-      s, "POST", "/api/transform",
-      json{{"handle", 0}, {"matrix", {c, -n, 0, 0, n, c, 0, 0, 0, 0, 1, 0.3}}, {"answer", answer}}
-          .dump());
+  return move(s, {c, -n, 0, 0, n, c, 0, 0, 0, 0, 1, 0.3}, answer);
 }
 
 // A relax step with a long budget gives way to a request that waits for the session: it ends
@@ -306,9 +303,7 @@ TEST(ServerThreads, ARelaxStepGivesWayToARequestThatWaits) {
 TEST(ServerThreads, AnUnconvergedRelaxStepLeavesTheSessionIterating) {
   Session s;
   set_nonlinear_region(s);
-  const auto converged = [&] {
-    return json::parse(call(s, "GET", "/api/status").body)["nonlinear"]["converged"].get<bool>();
-  };
+  const auto converged = [&] { return status_of(s)["nonlinear"]["converged"].get<bool>(); };
   ASSERT_EQ(turn(s, 1.2, "none").status, 204);
   const HttpResponse step = call(s, "POST", "/api/relax", R"({"budget_ms": 0.001})");
   ASSERT_EQ(step.status, 200) << step.body;
@@ -330,9 +325,9 @@ TEST(ServerThreads, AnUnconvergedRelaxStepLeavesTheSessionIterating) {
   const HttpResponse moved = turn(s, 0.5, "positions");
   ASSERT_EQ(moved.status, 200) << moved.body;
   if (moved.headers.at("X-Converged") == "0") {
-    const auto status = json::parse(call(s, "GET", "/api/status").body);
+    const auto status = status_of(s);
     std::this_thread::sleep_for(std::chrono::milliseconds(200));
-    const auto later = json::parse(call(s, "GET", "/api/status").body);
+    const auto later = status_of(s);
     EXPECT_EQ(later["nonlinear"]["iterations"], status["nonlinear"]["iterations"]);
     EXPECT_FALSE(later["nonlinear"]["converged"].get<bool>());
   }
