@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <cstdlib>
 #include <exception>
+#include <memory>
 #include <numeric>
 #include <string>
 
@@ -14,6 +15,7 @@
 #include <cholmod.h>
 
 #include "remora/linalg/cholmod_settings.h"
+#include "remora/linalg/supernodal_factor.h"
 #include "remora/linalg/supernodal_solve.h"
 
 extern "C" { // BLAS and LAPACK (OpenBLAS, whose kernels use the machine's vector width)
@@ -84,7 +86,8 @@ namespace split_detail {
 struct Half {
   cholmod_common c{};
   cholmod_factor* factor = nullptr;
-  std::vector<int> rows; // the global row of each local row of the half
+  std::unique_ptr<SupernodalNumeric> numeric; // factor's numeric factorization
+  std::vector<int> rows;                      // the global row of each local row of the half
   int n = 0;
   std::vector<int> colptr, rowind; // lower triangle of the bordered matrix, CSC
   std::vector<double> values;
@@ -147,6 +150,7 @@ struct Half {
     factor = cholmod_analyze_p(&m, perm.data(), nullptr, 0, &c);
     if (factor == nullptr)
       throw NumericalError("cholmod: the symbolic analysis failed (out of memory?)");
+    numeric = std::make_unique<SupernodalNumeric>(*factor, colptr.data(), rowind.data(), size());
     const int* p = static_cast<const int*>(factor->Perm);
     order.resize(static_cast<std::size_t>(separator_rows()));
     for (int k = n; k < size(); ++k) {
@@ -160,10 +164,7 @@ struct Half {
   // False when the half is not positive definite.
   bool factorize(const double* global_values) {
     for (std::size_t k = 0; k < values.size(); ++k) values[k] = global_values[source[k]];
-    cholmod_sparse m = view();
-    const int done = cholmod_factorize(&m, factor, &c);
-    if (c.status == CHOLMOD_NOT_POSDEF || (done && factor->minor < factor->n)) return false;
-    if (!done) throw NumericalError("cholmod: the factorization failed (out of memory?)");
+    if (!numeric->factorize(*factor, values.data(), c)) return false;
     const int s = separator_rows();
     lss.setZero(s, s);
     const auto* super = static_cast<const int*>(factor->super);

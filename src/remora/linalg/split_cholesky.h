@@ -6,8 +6,8 @@
 //
 //       [ A₁  0   C₁ ]
 //   K = [ 0   A₂  C₂ ]      each half bordered by S, M_i = [A_i C_i; C_iᵀ K_SS] = L_i L_iᵀ, is
-//       [ C₁ᵀ C₂ᵀ K_SS]     ordered with S last (by CAMD, or by the given order) and factored by
-//                           CHOLMOD on its thread.
+//       [ C₁ᵀ C₂ᵀ K_SS]     ordered with S last (by CAMD, or by the given order), analysed by
+//                           CHOLMOD and factored on its thread by supernodal_factor.h.
 //
 // The trailing block of L_i is the factor of K_SS − C_iᵀA_i⁻¹C_i, so the Schur complement of S is
 // L₁L₁ᵀ + L₂L₂ᵀ − K_SS (symmetric positive definite whenever K is), factored densely. A solve is a
