@@ -64,7 +64,7 @@ SupernodalNumeric::SupernodalNumeric(const cholmod_factor& symbolic, const int* 
       const int b = inverse[static_cast<std::size_t>(j)];
       const auto at = static_cast<std::size_t>(next[static_cast<std::size_t>(std::min(a, b))]++);
       row_[at] = std::max(a, b);
-      source_[at] = static_cast<std::size_t>(e);
+      source_[at] = e;
     }
   // Workspace: a descendant d's update has at most (rows − columns)² entries.
   super_of_.resize(static_cast<std::size_t>(n));
