@@ -24,8 +24,8 @@ SparseMatrix lower_system(int k) {
   Region region{std::vector<int>(mesh.n_vertices(), Region::kFree)};
   for (auto v : mesh.vertices())
     if (mesh.point(v)[2] < -0.5) region.label[static_cast<std::size_t>(v.idx())] = Region::kFixed;
-  SparseMatrix lower =
-      assemble_kharmonic(mesh, region, {.k = k, .areas = AreaWeights::Mean}).matrix.triangularView<Eigen::Lower>();
+  SparseMatrix lower = assemble_kharmonic(mesh, region, {.k = k, .areas = AreaWeights::Mean})
+                           .matrix.triangularView<Eigen::Lower>();
   lower.makeCompressed();
   return lower;
 }
@@ -133,9 +133,9 @@ TEST(SupernodalFactor, RefusesAnAnalysisThatDoesNotFit) {
                                  static_cast<int>(a.rows())),
                InvalidArgument);
   cholmod_factor* f = cm.analyze(a, true);
-  EXPECT_THROW(SupernodalNumeric(*f, a.outerIndexPtr(), a.innerIndexPtr(),
-                                 static_cast<int>(a.rows()) - 1),
-               InvalidArgument);
+  EXPECT_THROW(
+      SupernodalNumeric(*f, a.outerIndexPtr(), a.innerIndexPtr(), static_cast<int>(a.rows()) - 1),
+      InvalidArgument);
 }
 
 } // namespace

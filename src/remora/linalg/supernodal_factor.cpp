@@ -27,8 +27,8 @@ struct Structure {
 };
 
 Structure structure_of(const cholmod_factor& f, int n) {
-  if (!f.is_super || f.super == nullptr || f.pi == nullptr || f.px == nullptr ||
-      f.s == nullptr || f.Perm == nullptr)
+  if (!f.is_super || f.super == nullptr || f.pi == nullptr || f.px == nullptr || f.s == nullptr ||
+      f.Perm == nullptr)
     throw InvalidArgument("supernodal factorization: the analysis is not supernodal (analyse "
                           "with CHOLMOD_SUPERNODAL first)");
   if (static_cast<int>(f.n) != n)
@@ -104,8 +104,8 @@ bool SupernodalNumeric::factorize(cholmod_factor& factor, const double* values,
     std::fill(block, block + static_cast<std::size_t>(nsrow) * nscol, 0.0);
     for (int j = k1; j < k2; ++j) {
       double* column = block + static_cast<std::size_t>(j - k1) * nsrow;
-      for (int e = colptr_[static_cast<std::size_t>(j)]; e < colptr_[static_cast<std::size_t>(j) + 1];
-           ++e)
+      for (int e = colptr_[static_cast<std::size_t>(j)];
+           e < colptr_[static_cast<std::size_t>(j) + 1]; ++e)
         column[map_[static_cast<std::size_t>(row_[static_cast<std::size_t>(e)])]] +=
             values[source_[static_cast<std::size_t>(e)]];
     }

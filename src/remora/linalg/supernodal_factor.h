@@ -40,10 +40,10 @@ public:
 
 private:
   int n_ = 0;
-  std::vector<int> colptr_, row_;     // P A Pᵀ's lower triangle by the factor's columns
-  std::vector<int> source_;           // each entry's index in the constructor's values
-  std::vector<int> super_of_;         // the supernode of each column
-  std::vector<int> map_, relative_;   // workspace: a row's place in the current supernode
+  std::vector<int> colptr_, row_;      // P A Pᵀ's lower triangle by the factor's columns
+  std::vector<int> source_;            // each entry's index in the constructor's values
+  std::vector<int> super_of_;          // the supernode of each column
+  std::vector<int> map_, relative_;    // workspace: a row's place in the current supernode
   std::vector<int> head_, next_, pos_; // the supernodes waiting to update each supernode
   std::vector<double> update_;         // workspace: one descendant's update
 };
