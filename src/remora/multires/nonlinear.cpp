@@ -100,6 +100,7 @@ struct NonlinearDeformer::Impl {
   bool identity = true;
   // Anderson history: columns of differences of G values and residuals.
   Eigen::MatrixXd dg, df;
+  Eigen::MatrixXd gram; // dfᵀdf of the history's columns
   Eigen::VectorXd last_g, last_f;
   Eigen::VectorXd previous_guess;                 // the free rows of the last guess (x⁰ at first)
   int plain_steps = 0;                            // iterations left without an extrapolation
@@ -411,31 +412,65 @@ void NonlinearDeformer::Impl::update_constrained_rhs() {
   });
 }
 
-// Anderson's extrapolation from the history and the newest (g, f) (Walker & Ni 2011).
+// Anderson's extrapolation from the history and the newest (g, f) (Walker & Ni 2011). The
+// history's Gram matrix dfᵀdf is kept: a new column needs its products with the others only.
+// The long vectors go in blocks of a fixed size on the threads, and each product is summed over
+// the blocks in order, so the result does not depend on the number of threads.
 Eigen::VectorXd NonlinearDeformer::Impl::anderson(const Eigen::VectorXd& g,
                                                   const Eigen::VectorXd& f) {
   const int depth = options.anderson;
-  if (last_g.size() == g.size()) {
-    if (dg.cols() != depth || dg.rows() != g.size()) {
-      dg.resize(g.size(), depth);
-      df.resize(g.size(), depth);
+  const Eigen::Index length = g.size();
+  int slot = -1; // the history's column the newest differences go to
+  if (last_g.size() == length) {
+    if (dg.cols() != depth || dg.rows() != length) {
+      dg.resize(length, depth);
+      df.resize(length, depth);
+      gram.resize(depth, depth);
       history = 0;
     }
-    const int slot = history % depth;
-    dg.col(slot) = g - last_g;
-    df.col(slot) = f - last_f;
+    slot = history % depth;
     ++history;
+  } else {
+    last_g.resize(length);
+    last_f.resize(length);
   }
-  last_g = g;
-  last_f = f;
   const int m = std::min(history, depth);
+  constexpr Eigen::Index kBlock = 8192;
+  const auto blocks = static_cast<std::size_t>((length + kBlock - 1) / kBlock);
+  // Per block: rows 0..m−1 the history's products with the new column, rows depth.. with f.
+  Eigen::MatrixXd partial(2 * depth, static_cast<Eigen::Index>(blocks));
+  parallel_blocks(blocks, options.threads, [&](std::size_t b) {
+    const Eigen::Index lo = static_cast<Eigen::Index>(b) * kBlock,
+                       len = std::min(kBlock, length - lo);
+    if (slot >= 0) {
+      dg.col(slot).segment(lo, len) = g.segment(lo, len) - last_g.segment(lo, len);
+      df.col(slot).segment(lo, len) = f.segment(lo, len) - last_f.segment(lo, len);
+    }
+    for (int j = 0; j < m; ++j) {
+      const auto dj = df.col(j).segment(lo, len);
+      if (slot >= 0)
+        partial(j, static_cast<Eigen::Index>(b)) = dj.dot(df.col(slot).segment(lo, len));
+      partial(depth + j, static_cast<Eigen::Index>(b)) = dj.dot(f.segment(lo, len));
+    }
+    last_g.segment(lo, len) = g.segment(lo, len);
+    last_f.segment(lo, len) = f.segment(lo, len);
+  });
   if (m == 0) return g;
-  const auto dfm = df.leftCols(m); // views: a copy of the history is 2·3·n·m doubles
-  const auto dgm = dg.leftCols(m);
-  Eigen::MatrixXd normal = dfm.transpose() * dfm;
+  Eigen::VectorXd dot_f(m);
+  for (int j = 0; j < m; ++j) {
+    if (slot >= 0) gram(j, slot) = gram(slot, j) = partial.row(j).sum();
+    dot_f[j] = partial.row(depth + j).sum();
+  }
+  Eigen::MatrixXd normal = gram.topLeftCorner(m, m);
   normal.diagonal().array() += 1e-12 * normal.diagonal().maxCoeff() + 1e-300;
-  const Eigen::VectorXd theta = normal.ldlt().solve(dfm.transpose() * f);
-  return g - dgm * theta;
+  const Eigen::VectorXd theta = normal.ldlt().solve(dot_f);
+  Eigen::VectorXd out(length);
+  parallel_blocks(blocks, options.threads, [&](std::size_t b) {
+    const Eigen::Index lo = static_cast<Eigen::Index>(b) * kBlock,
+                       len = std::min(kBlock, length - lo);
+    out.segment(lo, len) = g.segment(lo, len) - dg.leftCols(m).middleRows(lo, len) * theta;
+  });
+  return out;
 }
 
 void NonlinearDeformer::Impl::iterate() {
