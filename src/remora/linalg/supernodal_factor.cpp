@@ -38,6 +38,35 @@ Structure structure_of(const cholmod_factor& f, int n) {
           static_cast<const int*>(f.px), static_cast<const int*>(f.s)};
 }
 
+// Subtracts from `block` (a supernode's, `rows` rows, its columns below `k2`, its rows' places in
+// `map`) the update of supernode d from d's rows at index `first` of its list on: the products of
+// those rows of d's block with the ones among the supernode's columns, formed in `c` (BLAS) and
+// scattered. Returns the index of d's first row past the supernode's columns.
+int subtract_update(const Structure& st, const double* lx, int d, int first, int k2,
+                    const std::vector<int>& map, std::vector<int>& relative, double* c,
+                    double* block, int rows) {
+  const double one = 1.0, zero = 0.0;
+  const int pdi = st.pi[d], pdend = st.pi[d + 1], ndrow = pdend - pdi;
+  const int ndcol = st.super[d + 1] - st.super[d];
+  int past = first;
+  while (past < pdend && st.s[past] < k2) ++past;
+  const int ndrow1 = past - first, ndrow2 = pdend - first, ndrow3 = ndrow2 - ndrow1;
+  const double* ld = lx + st.px[d] + (first - pdi);
+  dsyrk_("L", "N", &ndrow1, &ndcol, &one, ld, &ndrow, &zero, c, &ndrow2);
+  if (ndrow3 > 0)
+    dgemm_("N", "T", &ndrow3, &ndrow1, &ndcol, &one, ld + ndrow1, &ndrow, ld, &ndrow, &zero,
+           c + ndrow1, &ndrow2);
+  for (int i = 0; i < ndrow2; ++i)
+    relative[static_cast<std::size_t>(i)] = map[static_cast<std::size_t>(st.s[first + i])];
+  for (int j = 0; j < ndrow1; ++j) {
+    double* column = block + static_cast<std::size_t>(relative[static_cast<std::size_t>(j)]) *
+                                 static_cast<std::size_t>(rows);
+    const double* cj = c + static_cast<std::size_t>(j) * static_cast<std::size_t>(ndrow2);
+    for (int i = j; i < ndrow2; ++i) column[relative[static_cast<std::size_t>(i)]] -= cj[i];
+  }
+  return past;
+}
+
 } // namespace
 
 SupernodalNumeric::SupernodalNumeric(const cholmod_factor& symbolic, const int* colptr,
@@ -93,7 +122,7 @@ bool SupernodalNumeric::factorize(cholmod_factor& factor, const double* values,
     throw NumericalError("supernodal factorization: CHOLMOD could not allocate the factor (out "
                          "of memory?)");
   auto* lx = static_cast<double*>(factor.x);
-  const double one = 1.0, zero = 0.0;
+  const double one = 1.0;
   std::fill(head_.begin(), head_.end(), -1);
   for (int s = 0; s < static_cast<int>(factor.nsuper); ++s) {
     const int k1 = st.super[s], k2 = st.super[s + 1], nscol = k2 - k1;
@@ -112,26 +141,9 @@ bool SupernodalNumeric::factorize(cholmod_factor& factor, const double* values,
     // The updates of the supernodes below s whose next rows are s's columns.
     for (int d = head_[static_cast<std::size_t>(s)]; d != -1;) {
       const int following = next_[static_cast<std::size_t>(d)];
-      const int pdi = st.pi[d], pdend = st.pi[d + 1], ndrow = pdend - pdi;
-      const int ndcol = st.super[d + 1] - st.super[d];
-      const int pdi1 = pdi + pos_[static_cast<std::size_t>(d)];
-      int pdi2 = pdi1;
-      while (pdi2 < pdend && st.s[pdi2] < k2) ++pdi2;
-      const int ndrow1 = pdi2 - pdi1, ndrow2 = pdend - pdi1, ndrow3 = ndrow2 - ndrow1;
-      const double* ld = lx + st.px[d] + (pdi1 - pdi);
-      double* c = update_.data();
-      dsyrk_("L", "N", &ndrow1, &ndcol, &one, ld, &ndrow, &zero, c, &ndrow2);
-      if (ndrow3 > 0)
-        dgemm_("N", "T", &ndrow3, &ndrow1, &ndcol, &one, ld + ndrow1, &ndrow, ld, &ndrow, &zero,
-               c + ndrow1, &ndrow2);
-      for (int i = 0; i < ndrow2; ++i)
-        relative_[static_cast<std::size_t>(i)] = map_[static_cast<std::size_t>(st.s[pdi1 + i])];
-      for (int j = 0; j < ndrow1; ++j) {
-        double* column = block + static_cast<std::size_t>(relative_[static_cast<std::size_t>(j)]) *
-                                     static_cast<std::size_t>(nsrow);
-        const double* cj = c + static_cast<std::size_t>(j) * static_cast<std::size_t>(ndrow2);
-        for (int i = j; i < ndrow2; ++i) column[relative_[static_cast<std::size_t>(i)]] -= cj[i];
-      }
+      const int pdi = st.pi[d], pdend = st.pi[d + 1];
+      const int pdi2 = subtract_update(st, lx, d, pdi + pos_[static_cast<std::size_t>(d)], k2, map_,
+                                       relative_, update_.data(), block, nsrow);
       pos_[static_cast<std::size_t>(d)] = pdi2 - pdi;
       if (pdi2 < pdend) {
         const int t = super_of_[static_cast<std::size_t>(st.s[pdi2])];
