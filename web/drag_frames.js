@@ -47,8 +47,10 @@ export class RegionKernel {
 
 /// While the nonlinear iteration is not converged, more iterations once the pointer has rested
 /// PAUSE_MS (soon()), in relax steps whose budget doubles from BUDGET_MS to BUDGET_MAX_MS: a
-/// step's answer that is not converged asks for the next; a move (moved()) starts over, and a
-/// release (released()) has no pause to wait for. `submit(budget)` sends a step; `pending()`:
+/// step's answer that is not converged asks for the next; a move (moved()) starts over. A release
+/// (released()) has no pause to wait for and starts at BUDGET_MAX_MS: each answer's handling in
+/// the page takes the server's cores from the iteration, and a grab of the handle is not waited
+/// for longer than a pause's step. `submit(budget)` sends a step; `pending()`:
 /// a request waits to be sent (a newer move replaces a waiting step).
 export class Relaxer {
   static PAUSE_MS = 120;
@@ -59,7 +61,10 @@ export class Relaxer {
     this.lastMove = now;
     this.steps = 0;
   }
-  released(at) { this.lastMove = Math.min(this.lastMove, at - Relaxer.PAUSE_MS); }
+  released(at) {
+    this.lastMove = Math.min(this.lastMove, at - Relaxer.PAUSE_MS);
+    this.steps = Math.log2(Relaxer.BUDGET_MAX_MS / Relaxer.BUDGET_MS);
+  }
   /// No step is waiting for its pause.
   get idle() { return this.timer === null; }
   cancel() {
