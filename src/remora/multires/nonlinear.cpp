@@ -14,6 +14,7 @@
 #include "remora/common/timer.h"
 #include "remora/geometry/laplacian.h"
 #include "remora/geometry/measures.h"
+#include "remora/linalg/anderson.h"
 #include "remora/multires/best_rotation.h"
 #include "remora/multires/motion_blend.h"
 #include "remora/multires/rotation_blend.h"
@@ -98,14 +99,10 @@ struct NonlinearDeformer::Impl {
   NonlinearStats stats;
   double current_energy = 0.0;
   bool identity = true;
-  // Anderson history: columns of differences of G values and residuals.
-  Eigen::MatrixXd dg, df;
-  Eigen::MatrixXd gram; // dfᵀdf of the history's columns
-  Eigen::VectorXd last_g, last_f;
+  std::unique_ptr<AndersonAcceleration> anderson; // null without (options.anderson 0)
   Eigen::VectorXd previous_guess;                 // the free rows of the last guess (x⁰ at first)
   int plain_steps = 0;                            // iterations left without an extrapolation
   std::array<double, 3> decreases{0.0, 0.0, 0.0}; // of E in the last three iterations
-  int history = 0;
 
   std::size_t nf() const { return free_vertices.size(); }
 
@@ -262,7 +259,6 @@ struct NonlinearDeformer::Impl {
                                   .norm());
     return worst;
   }
-  Eigen::VectorXd anderson(const Eigen::VectorXd& g, const Eigen::VectorXd& f);
   void iterate();
 };
 
@@ -412,67 +408,6 @@ void NonlinearDeformer::Impl::update_constrained_rhs() {
   });
 }
 
-// Anderson's extrapolation from the history and the newest (g, f) (Walker & Ni 2011). The
-// history's Gram matrix dfᵀdf is kept: a new column needs its products with the others only.
-// The long vectors go in blocks of a fixed size on the threads, and each product is summed over
-// the blocks in order, so the result does not depend on the number of threads.
-Eigen::VectorXd NonlinearDeformer::Impl::anderson(const Eigen::VectorXd& g,
-                                                  const Eigen::VectorXd& f) {
-  const int depth = options.anderson;
-  const Eigen::Index length = g.size();
-  int slot = -1; // the history's column the newest differences go to
-  if (last_g.size() == length) {
-    if (dg.cols() != depth || dg.rows() != length) {
-      dg.resize(length, depth);
-      df.resize(length, depth);
-      gram.resize(depth, depth);
-      history = 0;
-    }
-    slot = history % depth;
-    ++history;
-  } else {
-    last_g.resize(length);
-    last_f.resize(length);
-  }
-  const int m = std::min(history, depth);
-  constexpr Eigen::Index kBlock = 8192;
-  const auto blocks = static_cast<std::size_t>((length + kBlock - 1) / kBlock);
-  // Per block: rows 0..m−1 the history's products with the new column, rows depth.. with f.
-  Eigen::MatrixXd partial(2 * depth, static_cast<Eigen::Index>(blocks));
-  parallel_blocks(blocks, options.threads, [&](std::size_t b) {
-    const Eigen::Index lo = static_cast<Eigen::Index>(b) * kBlock,
-                       len = std::min(kBlock, length - lo);
-    if (slot >= 0) {
-      dg.col(slot).segment(lo, len) = g.segment(lo, len) - last_g.segment(lo, len);
-      df.col(slot).segment(lo, len) = f.segment(lo, len) - last_f.segment(lo, len);
-    }
-    for (int j = 0; j < m; ++j) {
-      const auto dj = df.col(j).segment(lo, len);
-      if (slot >= 0)
-        partial(j, static_cast<Eigen::Index>(b)) = dj.dot(df.col(slot).segment(lo, len));
-      partial(depth + j, static_cast<Eigen::Index>(b)) = dj.dot(f.segment(lo, len));
-    }
-    last_g.segment(lo, len) = g.segment(lo, len);
-    last_f.segment(lo, len) = f.segment(lo, len);
-  });
-  if (m == 0) return g;
-  Eigen::VectorXd dot_f(m);
-  for (int j = 0; j < m; ++j) {
-    if (slot >= 0) gram(j, slot) = gram(slot, j) = partial.row(j).sum();
-    dot_f[j] = partial.row(depth + j).sum();
-  }
-  Eigen::MatrixXd normal = gram.topLeftCorner(m, m);
-  normal.diagonal().array() += 1e-12 * normal.diagonal().maxCoeff() + 1e-300;
-  const Eigen::VectorXd theta = normal.ldlt().solve(dot_f);
-  Eigen::VectorXd out(length);
-  parallel_blocks(blocks, options.threads, [&](std::size_t b) {
-    const Eigen::Index lo = static_cast<Eigen::Index>(b) * kBlock,
-                       len = std::min(kBlock, length - lo);
-    out.segment(lo, len) = g.segment(lo, len) - dg.leftCols(m).middleRows(lo, len) * theta;
-  });
-  return out;
-}
-
 void NonlinearDeformer::Impl::iterate() {
   const Eigen::VectorXd u = free_vector();
   const double before = current_energy;
@@ -490,13 +425,13 @@ void NonlinearDeformer::Impl::iterate() {
   const Eigen::VectorXd f = g - u;
   std::vector<Matrix3> rot(cells.size());
   bool accepted = false;
-  if (options.anderson > 0) {
-    const Eigen::VectorXd candidate = anderson(g, f);
+  if (anderson) {
+    const Eigen::VectorXd candidate = anderson->extrapolate(g, f);
     // After a rejected extrapolation the next two iterations are plain (each test costs a local
     // step).
     if (plain_steps > 0) {
       --plain_steps;
-    } else if (history > 0 && candidate.allFinite()) {
+    } else if (anderson->history() > 0 && candidate.allFinite()) {
       set_free(candidate);
       const double e = local_step(rot);
       if (e < current_energy) {
@@ -504,7 +439,7 @@ void NonlinearDeformer::Impl::iterate() {
         current_energy = e;
         ++stats.accelerated;
       } else { // keep only the newest point
-        history = 0;
+        anderson->restart();
         plain_steps = 2;
       }
     }
@@ -552,6 +487,8 @@ NonlinearDeformer::NonlinearDeformer(const Mesh& base, const Eigen::MatrixXd& re
   m.blended = options.energy == NonlinearEnergy::BlendedMotions;
   m.a = options.energy == NonlinearEnergy::Arap ? 0.0 : 1.0;
   m.beta = options.energy == NonlinearEnergy::Arap ? 1.0 : 0.0; // RotatedLaplacian: set by build()
+  if (options.anderson > 0)
+    m.anderson = std::make_unique<AndersonAcceleration>(options.anderson, options.threads);
   try {
     m.build(base, rest);
   } catch (const NumericalError& e) {
@@ -574,10 +511,9 @@ void NonlinearDeformer::set_transforms(const std::vector<AffineMap>& transforms,
     throw InvalidArgument(fmt::format("nonlinear deformer: {} transforms for {} handles",
                                       transforms.size(), handles));
   m.stats = NonlinearStats{};
-  m.history = 0;
+  if (m.anderson) m.anderson->clear();
   m.plain_steps = 0;
   m.decreases = {0.0, 0.0, 0.0};
-  m.last_g.resize(0);
   m.identity = std::all_of(transforms.begin(), transforms.end(), is_identity);
   if (m.identity) { // E = 0 at x⁰: the minimizer, exactly
     m.x = m.rest;
