@@ -24,9 +24,13 @@ void AndersonAcceleration::clear() {
   last_f_.resize(0);
 }
 
-void AndersonAcceleration::restart() { count_ = 0; }
+void AndersonAcceleration::restart() {
+  count_ = 0;
+}
 
-int AndersonAcceleration::history() const { return std::min(count_, depth_); }
+int AndersonAcceleration::history() const {
+  return std::min(count_, depth_);
+}
 
 Eigen::VectorXd AndersonAcceleration::extrapolate(const Eigen::VectorXd& g,
                                                   const Eigen::VectorXd& f) {
