@@ -15,18 +15,9 @@
 #include <cholmod.h>
 
 #include "remora/linalg/cholmod_settings.h"
+#include "remora/linalg/lapack.h"
 #include "remora/linalg/supernodal_factor.h"
 #include "remora/linalg/supernodal_solve.h"
-
-extern "C" { // BLAS and LAPACK (OpenBLAS, whose kernels use the machine's vector width)
-void dtrmm_(const char* side, const char* uplo, const char* transa, const char* diag, const int* m,
-            const int* n, const double* alpha, const double* a, const int* lda, double* b,
-            const int* ldb);
-void dpotrf_(const char* uplo, const int* n, double* a, const int* lda, int* info);
-void dlauum_(const char* uplo, const int* n, double* a, const int* lda, int* info);
-void dpotrs_(const char* uplo, const int* n, const int* nrhs, const double* a, const int* lda,
-             double* b, const int* ldb, int* info);
-}
 #endif
 
 namespace remora {
