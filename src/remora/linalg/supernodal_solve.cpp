@@ -9,6 +9,11 @@
 
 // The loops below ask for vectorization (`omp simd`: the reductions may be reordered), which the
 // sanitizer builds' -O1 does not do; clang warns that it was not done.
+//
+// On x86-64 the sweeps are compiled twice, for the baseline instruction set and for AVX2 with
+// FMA (`target` attribute, the kernels inlined into each), and the processor chooses at run time
+// (docs/solvers.md). Only those functions carry the attribute, so no inline function of a header
+// is compiled for AVX2 where the baseline one is meant.
 #if defined(__clang__)
 #pragma clang diagnostic push
 #pragma clang diagnostic ignored "-Wpass-failed"
@@ -57,7 +62,8 @@ Blocks blocks_of(const cholmod_factor& f) {
 
 /// Copies the supernode's rows of x into v: its own rows, and the rows below them (zero for the
 /// forward sweep, which sums into them).
-void load(const Supernode& n, const double* x, int cols, bool below, std::vector<double>& v) {
+[[gnu::always_inline]] inline void load(const Supernode& n, const double* x, int cols, bool below,
+                                        std::vector<double>& v) {
   const auto r = static_cast<std::size_t>(n.rows);
   v.resize(static_cast<std::size_t>(cols) * r);
   for (int i = 0; i < n.rows; ++i) {
@@ -70,7 +76,7 @@ void load(const Supernode& n, const double* x, int cols, bool below, std::vector
 }
 
 template <int C>
-void forward(const cholmod_factor& f, double* x, int columns) {
+[[gnu::always_inline]] inline void forward(const cholmod_factor& f, double* x, int columns) {
   const int cols = C > 0 ? C : columns;
   const Blocks blocks = blocks_of(f);
   thread_local std::vector<double> v;
@@ -119,7 +125,7 @@ void forward(const cholmod_factor& f, double* x, int columns) {
 }
 
 template <int C>
-void backward(const cholmod_factor& f, double* x, int columns) {
+[[gnu::always_inline]] inline void backward(const cholmod_factor& f, double* x, int columns) {
   const int cols = C > 0 ? C : columns;
   const Blocks blocks = blocks_of(f);
   thread_local std::vector<double> v;
@@ -170,20 +176,69 @@ void backward(const cholmod_factor& f, double* x, int columns) {
   }
 }
 
-} // namespace
-
-void supernodal_forward(const cholmod_factor& factor, double* x, int columns) {
+void forward_baseline(const cholmod_factor& f, double* x, int columns) {
   if (columns == 3)
-    forward<3>(factor, x, columns);
+    forward<3>(f, x, columns);
   else
-    forward<0>(factor, x, columns);
+    forward<0>(f, x, columns);
 }
 
-void supernodal_backward(const cholmod_factor& factor, double* x, int columns) {
+void backward_baseline(const cholmod_factor& f, double* x, int columns) {
   if (columns == 3)
-    backward<3>(factor, x, columns);
+    backward<3>(f, x, columns);
   else
-    backward<0>(factor, x, columns);
+    backward<0>(f, x, columns);
+}
+
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+[[gnu::target("avx2,fma")]] void forward_avx2(const cholmod_factor& f, double* x, int columns) {
+  if (columns == 3)
+    forward<3>(f, x, columns);
+  else
+    forward<0>(f, x, columns);
+}
+
+[[gnu::target("avx2,fma")]] void backward_avx2(const cholmod_factor& f, double* x, int columns) {
+  if (columns == 3)
+    backward<3>(f, x, columns);
+  else
+    backward<0>(f, x, columns);
+}
+
+bool avx2() {
+  static const bool yes = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
+  return yes;
+}
+#else // the baseline code only
+void forward_avx2(const cholmod_factor& f, double* x, int columns) {
+  forward_baseline(f, x, columns);
+}
+void backward_avx2(const cholmod_factor& f, double* x, int columns) {
+  backward_baseline(f, x, columns);
+}
+bool avx2() {
+  return false;
+}
+#endif
+
+} // namespace
+
+bool sweeps_use_avx2() {
+  return avx2();
+}
+
+void supernodal_forward(const cholmod_factor& factor, double* x, int columns, SweepCode code) {
+  if (code == SweepCode::Best && avx2())
+    forward_avx2(factor, x, columns);
+  else
+    forward_baseline(factor, x, columns);
+}
+
+void supernodal_backward(const cholmod_factor& factor, double* x, int columns, SweepCode code) {
+  if (code == SweepCode::Best && avx2())
+    backward_avx2(factor, x, columns);
+  else
+    backward_baseline(factor, x, columns);
 }
 
 } // namespace remora
