@@ -343,8 +343,8 @@ json region_above(const SphereRegion& r, double z) {
 
 // Method nonlinear: a new region is shown before its nonlinear state is built on the worker.
 // Meanwhile moves answer the linear frame, not converged, and a relax step waits for the state
-// at most its budget; once it is there a relax step converges; a new region stops a build and
-// follows it.
+// at most its budget, or until a move; once it is there a relax step converges; a new region
+// stops a build and follows it.
 TEST(ServerThreads, ANonlinearRegionIsShownWhileItsNonlinearStateIsBuilt) {
   Gate gate("nonlinear state");
   Session s(gate.options());
@@ -364,7 +364,28 @@ TEST(ServerThreads, ANonlinearRegionIsShownWhileItsNonlinearStateIsBuilt) {
   ASSERT_EQ(waited.status, 200) << waited.body;
   EXPECT_EQ(waited.headers.at("X-Converged"), "0");
   EXPECT_EQ(waited.body, moved.body); // still the linear frame
+  // A step with a long budget waiting for the state ends when a move comes (the page sends a
+  // grab of the handle during a step at once): moves until it has answered, within 5 s.
+  std::atomic<bool> answered{false};
+  HttpResponse long_step;
+  std::thread stepper([&] {
+    long_step = call(s, "POST", "/api/relax", R"({"budget_ms": 10000})");
+    answered = true;
+  });
+  int moves = 0;
+  const auto t0 = std::chrono::steady_clock::now();
+  while (!answered && std::chrono::steady_clock::now() - t0 < std::chrono::seconds(5)) {
+    moves += move(s, turn).status == 200;
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
+  const bool gave_way = answered;
   gate.release();
+  stepper.join();
+  EXPECT_TRUE(gave_way) << moves << " moves did not end the step";
+  ASSERT_EQ(long_step.status, 200) << long_step.body;
+  if (gave_way) {
+    EXPECT_EQ(long_step.headers.at("X-Converged"), "0");
+  }
   const HttpResponse relaxed = call(s, "POST", "/api/relax", R"({"budget_ms": 10000})");
   ASSERT_EQ(relaxed.status, 200) << relaxed.body;
   EXPECT_EQ(relaxed.headers.at("X-Converged"), "1");

@@ -48,22 +48,29 @@ export class RegionKernel {
 /// While the nonlinear iteration is not converged, more iterations once the pointer has rested
 /// PAUSE_MS (soon()), in relax steps whose budget doubles from BUDGET_MS to BUDGET_MAX_MS: a
 /// step's answer that is not converged asks for the next; a move (moved()) starts over. A release
-/// (released()) has no pause to wait for and starts at BUDGET_MAX_MS: each answer's handling in
-/// the page takes the server's cores from the iteration, and a grab of the handle is not waited
-/// for longer than a pause's step. `submit(budget)` sends a step; `pending()`:
-/// a request waits to be sent (a newer move replaces a waiting step).
+/// (released()) has no pause to wait for: its first step has RELEASE_BUDGET_MS, so that the
+/// iteration usually converges in one step (each answer's handling in the page takes the server's
+/// cores from the iteration), and later ones BUDGET_MAX_MS. A grab of the handle does not wait
+/// for a long step: its move is sent at once and ends the step (app.js's frames). `submit(budget)`
+/// sends a step; `pending()`: a request waits to be sent (a newer move replaces a waiting step),
+/// or a step is in flight (its answer asks for the next).
 export class Relaxer {
   static PAUSE_MS = 120;
   static BUDGET_MS = 40;
   static BUDGET_MAX_MS = 320;
-  constructor(submit, pending) { Object.assign(this, { submit, pending, lastMove: 0, timer: null, steps: 0 }); }
+  static RELEASE_BUDGET_MS = 1500;
+  constructor(submit, pending) {
+    Object.assign(this, { submit, pending, lastMove: 0, timer: null, steps: 0, afterRelease: false });
+  }
   moved(now) {
     this.lastMove = now;
     this.steps = 0;
+    this.afterRelease = false;
   }
   released(at) {
     this.lastMove = Math.min(this.lastMove, at - Relaxer.PAUSE_MS);
     this.steps = Math.log2(Relaxer.BUDGET_MAX_MS / Relaxer.BUDGET_MS);
+    this.afterRelease = true;
   }
   /// No step is waiting for its pause.
   get idle() { return this.timer === null; }
@@ -76,10 +83,11 @@ export class Relaxer {
     const wait = Math.max(0, this.lastMove + Relaxer.PAUSE_MS - performance.now());
     this.timer = setTimeout(() => {
       this.timer = null;
-      const budget = Math.min(Relaxer.BUDGET_MAX_MS, Relaxer.BUDGET_MS * 2 ** this.steps);
+      const budget = this.afterRelease ? Relaxer.RELEASE_BUDGET_MS : Math.min(Relaxer.BUDGET_MAX_MS, Relaxer.BUDGET_MS * 2 ** this.steps);
       if (!this.pending() && performance.now() - this.lastMove >= Relaxer.PAUSE_MS) {
         this.submit(budget);
         ++this.steps;
+        this.afterRelease = false;
       } else if (!this.pending()) this.soon();
     }, wait);
   }

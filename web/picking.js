@@ -23,31 +23,48 @@ export async function pick(ray, radius, brush, stroke) {
 /// At most one request in flight; a newer submission replaces a waiting one (the latest wins, so
 /// the answers never lag behind a queue). send(request) returns a promise; its result goes to
 /// receive(result, request); a failure is left to send (api() has shown the message).
+/// `overtakes(waiting, inFlight)` (default never): whether a waiting request is sent at once, while
+/// the one in flight is unanswered (then two are in flight, no more); answers are received in the
+/// order the requests were sent.
 export class Coalescer {
-  constructor(send, receive) {
-    this.send = send;
-    this.receive = receive;
-    this.pending = null;
-    this.inFlight = null;
+  constructor(send, receive, overtakes = () => false) {
+    Object.assign(this, { send, receive, overtakes, pending: null, inFlight: null, current: null, early: null });
   }
   /// Queues `request`; resolves when it (or a later request that replaced it) has been answered.
   submit(request) {
     this.pending = request;
     if (!this.inFlight) this.inFlight = this.drain();
+    else if (this.current && !this.early && this.overtakes(request, this.current)) {
+      this.pending = null;
+      this.early = { request, answer: this.start(request) };
+      this.early.answer.catch(() => {}); // received (or its failure dropped) by drain()
+    }
     return this.inFlight;
   }
+  start(request) {
+    try { return this.send(request); } catch (e) { return Promise.reject(e); }
+  }
+  /// The requests sent and not yet answered (at most two).
+  get sent() { return [this.current, this.early?.request].filter(Boolean); }
   /// Resolves when nothing is in flight or waiting.
   idle() { return this.inFlight ?? Promise.resolve(); }
   get busy() { return !!this.inFlight; }
   async drain() {
     try {
-      while (this.pending) {
-        const request = this.pending;
-        this.pending = null;
-        try { this.receive(await this.send(request), request); } catch (e) { /* shown by api() */ }
+      while (this.early || this.pending) {
+        let request = this.early?.request, answer = this.early?.answer;
+        if (this.early) this.early = null;
+        else {
+          request = this.pending;
+          this.pending = null;
+          answer = this.start(request);
+        }
+        this.current = request;
+        try { this.receive(await answer, request); } catch (e) { /* shown by api() */ }
       }
     } finally {
       this.inFlight = null;
+      this.current = null;
     }
   }
 }

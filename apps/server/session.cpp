@@ -164,7 +164,9 @@ Frame Session::set_transform(int handle, const Transform& transform, FrameAnswer
   m.require_offsets(answer);
   m.box->editor.set_transform(handle, transform); // validates
   m.transforms[static_cast<std::size_t>(handle)] = transform;
-  m.relax_on = false; // the page relaxes again after its pause
+  ++m.moves;
+  m.idle.notify_all(); // a relax step waiting for the nonlinear state answers first
+  m.relax_on = false;  // the page relaxes again after its pause
   if (answer != FrameAnswer::None) return m.frame(m.options.frame_budget_ms, answer);
   m.shape_behind = true;
   return {}; // no positions, no frame time
@@ -179,9 +181,10 @@ Frame Session::relax(double budget_ms, FrameAnswer answer) {
     throw InvalidArgument("budget_ms: expected milliseconds above 0, at most 10000");
   if (answer == FrameAnswer::None) throw InvalidArgument("a relax step answers something");
   const auto t0 = Clock::now();
-  if (m.finishing) { // the region's nonlinear state first, within the budget
+  if (m.finishing) { // the region's nonlinear state first, within the budget, unless a move comes
+    const std::uint64_t moves = m.moves;
     m.idle.wait_for(lock, std::chrono::duration<double, std::milli>(budget_ms),
-                    [&m] { return !m.finishing; });
+                    [&m, moves] { return !m.finishing || m.moves != moves; });
     m.require_region(); // a job may have begun meanwhile
     budget_ms = std::max(1.0, budget_ms - ms_since(t0));
   }

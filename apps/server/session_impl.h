@@ -63,7 +63,7 @@ struct Session::Impl {
     --waiting;
     return lock;
   }
-  std::condition_variable idle; // a job ended, or the region's nonlinear state is there
+  std::condition_variable idle; // a job ended, the region's nonlinear state is there, or a move
   std::thread worker;
   /// Method nonlinear: a relax step ended before the iteration converged, so the relaxer thread
   /// iterates on between requests (relax_loop()) until it converges or something else changes
@@ -108,6 +108,8 @@ struct Session::Impl {
   // Change counters (status): the faces (a load), the positions other than through a frame of
   // set_transform (load, undo, redo, a new k under moved handles), the region.
   std::uint64_t mesh_id = 0, positions_id = 0, region_id = 0;
+  /// set_transform() calls: a relax step waiting for the nonlinear state ends at a move.
+  std::uint64_t moves = 0;
 
   void require_ready() const {
     if (busy) throw Busy(fmt::format("the session is busy ({}: {})", job, phase));
