@@ -5,15 +5,14 @@
 #include <cstddef>
 #include <vector>
 
+#include "remora/common/cpu.h"
 #include "remora/common/error.h"
 
 // The loops below ask for vectorization (`omp simd`: the reductions may be reordered), which the
 // sanitizer builds' -O1 does not do; clang warns that it was not done.
 //
-// On x86-64 the sweeps are compiled twice, for the baseline instruction set and for AVX2 with
-// FMA (`target` attribute, the kernels inlined into each), and the processor chooses at run time
-// (docs/solvers.md). Only those functions carry the attribute, so no inline function of a header
-// is compiled for AVX2 where the baseline one is meant.
+// The sweeps are compiled for the baseline instruction set and for AVX2 with FMA, the kernels
+// inlined into each, and the processor chooses at run time (common/cpu.h, docs/solvers.md).
 #if defined(__clang__)
 #pragma clang diagnostic push
 #pragma clang diagnostic ignored "-Wpass-failed"
@@ -190,52 +189,31 @@ void backward_baseline(const cholmod_factor& f, double* x, int columns) {
     backward<0>(f, x, columns);
 }
 
-#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
-[[gnu::target("avx2,fma")]] void forward_avx2(const cholmod_factor& f, double* x, int columns) {
+REMORA_AVX2 void forward_avx2(const cholmod_factor& f, double* x, int columns) {
   if (columns == 3)
     forward<3>(f, x, columns);
   else
     forward<0>(f, x, columns);
 }
 
-[[gnu::target("avx2,fma")]] void backward_avx2(const cholmod_factor& f, double* x, int columns) {
+REMORA_AVX2 void backward_avx2(const cholmod_factor& f, double* x, int columns) {
   if (columns == 3)
     backward<3>(f, x, columns);
   else
     backward<0>(f, x, columns);
 }
 
-bool avx2() {
-  static const bool yes = __builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma");
-  return yes;
-}
-#else // the baseline code only
-void forward_avx2(const cholmod_factor& f, double* x, int columns) {
-  forward_baseline(f, x, columns);
-}
-void backward_avx2(const cholmod_factor& f, double* x, int columns) {
-  backward_baseline(f, x, columns);
-}
-bool avx2() {
-  return false;
-}
-#endif
-
 } // namespace
 
-bool sweeps_use_avx2() {
-  return avx2();
-}
-
-void supernodal_forward(const cholmod_factor& factor, double* x, int columns, SweepCode code) {
-  if (code == SweepCode::Best && avx2())
+void supernodal_forward(const cholmod_factor& factor, double* x, int columns) {
+  if (use_avx2())
     forward_avx2(factor, x, columns);
   else
     forward_baseline(factor, x, columns);
 }
 
-void supernodal_backward(const cholmod_factor& factor, double* x, int columns, SweepCode code) {
-  if (code == SweepCode::Best && avx2())
+void supernodal_backward(const cholmod_factor& factor, double* x, int columns) {
+  if (use_avx2())
     backward_avx2(factor, x, columns);
   else
     backward_baseline(factor, x, columns);
