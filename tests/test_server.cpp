@@ -137,6 +137,9 @@ TEST(Server, EditRoundTripWithUndoAndRedo) {
   expect_error(
       call(s, "POST", "/api/transform", R"({"handle": 0, "matrix": [1,0,0,0,0,1,0,0,0,0,1,"x"]})"),
       400, "matrix[11]");
+  expect_error(call(s, "POST", "/api/transform",
+                    R"({"handle": 0, "matrix": [1,0,0,0,0,1,0,0,0,0,1,0], "relax": 1})"),
+               400, "relax: expected true");
   const HttpResponse moved =
       call(s, "POST", "/api/transform", R"({"handle": 0, "matrix": [1,0,0,0,0,1,0,0,0,0,1,0.5]})");
   ASSERT_EQ(moved.status, 200) << moved.body;

@@ -333,6 +333,36 @@ TEST(ServerThreads, AnUnconvergedRelaxStepLeavesTheSessionIterating) {
   }
 }
 
+// A drag's last move with "relax": true leaves the session iterating after its answer, as an
+// unconverged relax step does: the status turns converged with no relax step; without it nothing
+// iterates until one comes. (The moves answer nothing here: a frame of this small region could
+// converge within the move's own budget.)
+TEST(ServerThreads, ADragsLastMoveCanLeaveTheSessionIterating) {
+  Session s;
+  set_nonlinear_region(s);
+  const auto nonlinear = [&] { return status_of(s)["nonlinear"]; };
+  const auto last_move = [&](double a, bool relax) {
+    const double c = std::cos(a), n = std::sin(a);
+    const json body{{"handle", 0},
+                    {"matrix", {c, -n, 0, 0, n, c, 0, 0, 0, 0, 1, 0.3}},
+                    {"answer", "none"},
+                    {"relax", relax}};
+    return call(s, "POST", "/api/transform", body.dump());
+  };
+  ASSERT_EQ(last_move(1.0, false).status, 204);
+  const int iterations = nonlinear()["iterations"].get<int>();
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  EXPECT_EQ(nonlinear()["iterations"], iterations); // nothing iterates without a relax step
+  EXPECT_FALSE(nonlinear()["converged"].get<bool>());
+
+  ASSERT_EQ(last_move(1.3, true).status, 204);
+  const auto t0 = std::chrono::steady_clock::now();
+  while (!nonlinear()["converged"].get<bool>() &&
+         std::chrono::steady_clock::now() - t0 < std::chrono::seconds(60))
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  EXPECT_TRUE(nonlinear()["converged"].get<bool>());
+}
+
 /// The support of SphereRegion's sphere above z = `z`, its handle above z = 0.9.
 json region_above(const SphereRegion& r, double z) {
   std::vector<int> support;

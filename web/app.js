@@ -424,9 +424,9 @@ function receiveOffsets(result, request) {
   state.converged = result.converged;
   if (!result.converged) relaxer.soon();
 }
-// A move goes out while a relax step is in flight (the server ends the step after the iteration
-// under way and answers it first), and a relax step while the drag's last move is.
-const overtakes = (waiting, inFlight) => (inFlight.relax && !waiting.relax) || (waiting.relax && !!inFlight.last);
+// A move goes out while a relax step is in flight: the server ends the step after the iteration
+// under way and answers it first.
+const overtakes = (waiting, inFlight) => inFlight.relax && !waiting.relax;
 const frames = new Coalescer((request) => sendFrame(request, request.budget ?? Relaxer.BUDGET_MS), (result, request) => {
   receiveOffsets(result, request);
   if (request.local) return; // shown by localFrame(), which also timed it
@@ -476,10 +476,8 @@ gizmo.addEventListener('dragging-changed', (event) => {
   const handle = state.selected, last = draggedLocally;
   task(async () => {
     // The page showed its own frames: the drag ends on the server's (the reference).
-    if (last) {
-      frames.submit({ handle, matrix: matrixToRows(state.transforms[handle]), t0: performance.now(), last: true, offsets: kernelCorrected(), kernel });
-      if (kernelCorrected()) relaxer.soon(); // the iteration goes on at once
-    }
+    // The server iterates on after answering it ("relax": true) until the relax step comes.
+    if (last) frames.submit({ handle, matrix: matrixToRows(state.transforms[handle]), t0: performance.now(), last: true, offsets: kernelCorrected(), kernel });
     await frames.idle();
     try { await post('commit'); state.status = await json('status'); panels.showStats(state.status, state.frameMs); } catch (e) { /* shown */ }
     if (baseShown()) await showBase(false);

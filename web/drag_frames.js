@@ -100,9 +100,10 @@ function frameAnswer(request) {
   return request.offsets ? 'positions-and-base-offsets' : 'positions';
 }
 
-/// A frame request: a handle's new map (POST transform), or for the nonlinear method more
-/// iterations under the same maps while the pointer rests (POST relax, `relaxBudgetMs`). Resolves
-/// to { moved, offsets, bytes, ms, converged } of the answer.
+/// A frame request: a handle's new map (POST transform; the drag's last, `request.last`, leaves
+/// the server iterating on), or for the nonlinear method more iterations under the same maps
+/// while the pointer rests (POST relax, `relaxBudgetMs`). Resolves to { moved, offsets, bytes,
+/// ms, converged } of the answer.
 export async function sendFrame(request, relaxBudgetMs) {
   request.sent = performance.now();
   const answer = frameAnswer(request);
@@ -111,7 +112,8 @@ export async function sendFrame(request, relaxBudgetMs) {
     ? await fetch('api/relax', { method: 'POST', headers: { 'Content-Type': 'application/json' },
                                  body: JSON.stringify({ budget_ms: relaxBudgetMs, answer }) })
     : await api('transform', { method: 'POST', headers: { 'Content-Type': 'application/json' },
-                               body: JSON.stringify({ handle: request.handle, matrix: request.matrix, answer }) });
+                               body: JSON.stringify({ handle: request.handle, matrix: request.matrix, answer,
+                                                      relax: !!request.last }) });
   if (!response.ok) throw new ApiError(response.status, 'relax refused');
   const buffer = await bodyBytes(response), floats = new Float32Array(buffer);
   const withOffsets = response.headers.has('X-Base-Offset-Rows');

@@ -208,8 +208,11 @@ FrameAnswer frame_answer(const json& j) {
 
 HttpResponse transform(Session& session, const HttpRequest& request, const ApiLimits& limits) {
   const json j = parse_json(request, limits);
-  only_keys(j, {"handle", "matrix", "answer"});
+  only_keys(j, {"handle", "matrix", "answer", "relax"});
   const FrameAnswer answer = frame_answer(j);
+  if (j.contains("relax") && !j.at("relax").is_boolean())
+    throw BadRequest("relax: expected true (go on iterating after the answer) or false");
+  const bool then_relax = j.value("relax", false);
   if (!j.contains("handle") || !j.at("handle").is_number_integer())
     throw BadRequest("handle: expected a handle index");
   const json& m = j.contains("matrix") ? j.at("matrix") : json();
@@ -223,8 +226,8 @@ HttpResponse transform(Session& session, const HttpRequest& request, const ApiLi
         throw BadRequest(fmt::format("matrix[{}]: expected a finite number", 4 * r + c));
       t(r, c) = x.get<double>();
     }
-  HttpResponse r =
-      frame_response(session.set_transform(j.at("handle").get<int>(), t, answer), answer);
+  HttpResponse r = frame_response(
+      session.set_transform(j.at("handle").get<int>(), t, answer, then_relax), answer);
   if (answer == FrameAnswer::None) {
     r.status = 204;
     r.body.clear();

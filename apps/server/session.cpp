@@ -157,7 +157,8 @@ void Session::wait_for(std::chrono::milliseconds timeout) {
   impl_->idle.wait_for(lock, timeout, [&] { return !impl_->busy; });
 }
 
-Frame Session::set_transform(int handle, const Transform& transform, FrameAnswer answer) {
+Frame Session::set_transform(int handle, const Transform& transform, FrameAnswer answer,
+                             bool then_relax) {
   auto lock = impl_->acquire();
   Impl& m = *impl_;
   m.require_region();
@@ -167,9 +168,16 @@ Frame Session::set_transform(int handle, const Transform& transform, FrameAnswer
   ++m.moves;
   m.idle.notify_all(); // a relax step waiting for the nonlinear state answers first
   m.relax_on = false;  // the page relaxes again after its pause
-  if (answer != FrameAnswer::None) return m.frame(m.options.frame_budget_ms, answer);
-  m.shape_behind = true;
-  return {}; // no positions, no frame time
+  Frame f;
+  if (answer != FrameAnswer::None)
+    f = m.frame(m.options.frame_budget_ms, answer);
+  else
+    m.shape_behind = true;                        // no positions, no frame time
+  if (then_relax && !m.box->editor.converged()) { // the relaxer iterates while the answer travels
+    m.relax_on = true;
+    m.relax_wake.notify_one();
+  }
+  return f;
 }
 
 Frame Session::relax(double budget_ms, FrameAnswer answer) {

@@ -108,8 +108,10 @@ public:
   /// now (a client that evaluates its own linear frames: the page) and the Frame holds nothing;
   /// the frame is computed when something reads the shape (a pick, the positions, an export, the
   /// next answered move). Base offsets for the energy blended-motions throw InvalidArgument.
+  /// With `then_relax` (the last move of a drag, after which the page asks for relax steps),
+  /// method nonlinear goes on iterating after the answer, as after an unconverged relax step.
   Frame set_transform(int handle, const Transform& transform,
-                      FrameAnswer answer = FrameAnswer::Positions);
+                      FrameAnswer answer = FrameAnswer::Positions, bool then_relax = false);
   /// Method nonlinear: iterates for at most `budget_ms` more under the live transforms (the
   /// page calls it while the user pauses, until converged), ending after the iteration under
   /// way when another call waits for the session. Method linear: the frame as it is, converged.
