@@ -166,8 +166,8 @@ Frame Session::set_transform(int handle, const Transform& transform, FrameAnswer
   m.box->editor.set_transform(handle, transform); // validates
   m.transforms[static_cast<std::size_t>(handle)] = transform;
   ++m.moves;
-  m.idle.notify_all(); // a relax step waiting for the nonlinear state answers first
-  m.relax_on = false;  // the page relaxes again after its pause
+  if (m.finishing) m.idle.notify_all(); // a relax step waiting for the nonlinear state answers
+  m.relax_on = false;                   // the page relaxes again after its pause
   Frame f;
   if (answer != FrameAnswer::None)
     f = m.frame(m.options.frame_budget_ms, answer);

@@ -175,48 +175,31 @@ template <int C>
   }
 }
 
-void forward_baseline(const cholmod_factor& f, double* x, int columns) {
-  if (columns == 3)
-    forward<3>(f, x, columns);
+/// One sweep; 3 columns (the nonlinear deformer's) in code compiled for that count.
+[[gnu::always_inline]] inline void sweep(bool forward_sweep, const cholmod_factor& f, double* x,
+                                         int columns) {
+  if (forward_sweep)
+    columns == 3 ? forward<3>(f, x, columns) : forward<0>(f, x, columns);
   else
-    forward<0>(f, x, columns);
+    columns == 3 ? backward<3>(f, x, columns) : backward<0>(f, x, columns);
 }
 
-void backward_baseline(const cholmod_factor& f, double* x, int columns) {
-  if (columns == 3)
-    backward<3>(f, x, columns);
-  else
-    backward<0>(f, x, columns);
+void sweep_baseline(bool forward_sweep, const cholmod_factor& f, double* x, int columns) {
+  sweep(forward_sweep, f, x, columns);
 }
 
-REMORA_AVX2 void forward_avx2(const cholmod_factor& f, double* x, int columns) {
-  if (columns == 3)
-    forward<3>(f, x, columns);
-  else
-    forward<0>(f, x, columns);
-}
-
-REMORA_AVX2 void backward_avx2(const cholmod_factor& f, double* x, int columns) {
-  if (columns == 3)
-    backward<3>(f, x, columns);
-  else
-    backward<0>(f, x, columns);
+REMORA_AVX2 void sweep_avx2(bool forward_sweep, const cholmod_factor& f, double* x, int columns) {
+  sweep(forward_sweep, f, x, columns);
 }
 
 } // namespace
 
 void supernodal_forward(const cholmod_factor& factor, double* x, int columns) {
-  if (use_avx2())
-    forward_avx2(factor, x, columns);
-  else
-    forward_baseline(factor, x, columns);
+  use_avx2() ? sweep_avx2(true, factor, x, columns) : sweep_baseline(true, factor, x, columns);
 }
 
 void supernodal_backward(const cholmod_factor& factor, double* x, int columns) {
-  if (use_avx2())
-    backward_avx2(factor, x, columns);
-  else
-    backward_baseline(factor, x, columns);
+  use_avx2() ? sweep_avx2(false, factor, x, columns) : sweep_baseline(false, factor, x, columns);
 }
 
 } // namespace remora
