@@ -242,7 +242,8 @@ public:
   /// were. One of the last two regions installed before this one, set again with the same ids
   /// and system (an undo), is installed as it was, without the work: the same positions bit for
   /// bit. Those kept regions are dropped, the oldest first, when a new region would not fit
-  /// beside them in options().memory_bytes.
+  /// beside them in options().memory_bytes, before its work (so also when that work then fails):
+  /// they are a cache, and a dropped one set again is built again.
   void set_region(const std::vector<int>& support, const std::vector<std::vector<int>>& handles,
                   const std::stop_token& stop = {});
 

@@ -39,6 +39,13 @@ std::vector<int> margin_faces(const Mesh& base, const TriangleTopology& t,
   return faces;
 }
 
+// Throws NumericalError when a free vertex of `x` is not finite.
+void require_finite(const RowPoints& x, const std::vector<int>& free, const char* what) {
+  for (const int v : free)
+    if (!x.row(v).allFinite())
+      throw NumericalError(fmt::format("{} produced a non-finite position", what));
+}
+
 } // namespace
 
 RemeshResult make_coarse_base(const Mesh& base, const TriangleTopology& topology,
@@ -133,6 +140,7 @@ void NonlinearRegion::frame(const std::vector<AffineMap>& transforms, bool moved
       stats_ = preview_->solve(budget_ms, interrupt);
       level_ = "coarse";
       preview_->compose(linear_, base);
+      require_finite(base, free_, "the coarse preview");
       if (!stats_.finished() || ms_since(t0) >= budget_ms || (interrupt && interrupt())) return;
       // The handles moved in this frame: the preview is what it shows, and the fine level (one
       // iteration of which costs several of the preview's) starts once they rest.
@@ -146,9 +154,7 @@ void NonlinearRegion::frame(const std::vector<AffineMap>& transforms, bool moved
     stats_ = fine_->solve(std::max(0.0, budget_ms - ms_since(t0)), interrupt);
     level_ = "fine";
     const RowPoints& x = fine_->positions();
-    for (const int v : free_)
-      if (!x.row(v).allFinite())
-        throw NumericalError("the iteration produced a non-finite position");
+    require_finite(x, free_, "the iteration");
     for (const int v : free_) base.row(v) = x.row(v);
   } catch (const Error& e) {
     fallback_ =
