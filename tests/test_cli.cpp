@@ -312,6 +312,30 @@ TEST_F(Cli, BenchEditTimesRegionsOnABakedBase) {
   EXPECT_EQ(run("bench edit " + in.string() + " --bake-first -1").exit_code, 2);
 }
 
+// `remora bench edit --method nonlinear --energy E`: the drag's frames and the converged result
+// after it, under the energy asked for (the iterative one iterates); an unknown method is a usage
+// error.
+TEST_F(Cli, BenchEditTimesTheNonlinearMethod) {
+  const fs::path in = dir_ / "sphere.off";
+  write_mesh(in.string(), make_icosphere(4)); // 2,562 vertices
+  for (const std::string energy : {"rotated-laplacian", "blended-motions"}) {
+    const CliRun r =
+        run("bench edit " + in.string() +
+            " --support 1200 --frames 3 --method nonlinear --energy " + energy + " --json");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    const nlohmann::json j = nlohmann::json::parse(r.out);
+    EXPECT_EQ(j["bench"]["method"], "nonlinear");
+    EXPECT_EQ(j["nonlinear"]["energy_name"], energy);
+    EXPECT_TRUE(j["nonlinear"]["converged"].get<bool>()) << j["nonlinear"];
+    EXPECT_EQ(j["nonlinear"]["fallback"], "");
+    EXPECT_EQ(j["bench"]["frames"], 3);
+    if (energy == "rotated-laplacian") {
+      EXPECT_GE(j["nonlinear"]["total_iterations"].get<int>(), 1) << j["nonlinear"];
+    }
+  }
+  EXPECT_EQ(run("bench edit " + in.string() + " --method arap").exit_code, 2);
+}
+
 // docs/editing.md's examples, run as documented: every ```json block on the bundled bunny, and
 // the quick-flag form of the first one, which must give the same mesh.
 TEST_F(Cli, EditRunsTheDocumentedExamples) {
@@ -376,6 +400,19 @@ TEST_F(Cli, EditRefinesTheSupportWhenAsked) {
     if (sphere.point(v)[2] < 0.0) {
       EXPECT_LT((result.point(v) - sphere.point(v)).norm(), 1e-6);
     }
+  // The same edit as EDIT.json with "refine_support": the same mesh.
+  const fs::path edit = dir_ / "refine.json";
+  std::ofstream(edit) << R"({"refine_support": true,
+    "support": {"sphere": {"center": [0, 0, 1], "radius": 0.8}},
+    "handles": [{"region": {"sphere": {"center": [0, 0, 1], "radius": 0.2}},
+                 "transform": {"translate": [0, 0, 0.1]}}]})";
+  const fs::path out_json = dir_ / "out_json.ply";
+  ASSERT_EQ(run("edit " + in.string() + " -o " + out_json.string() + " --edit " + edit.string())
+                .exit_code,
+            0);
+  const Mesh from_json = read_mesh(out_json.string()).mesh;
+  ASSERT_EQ(from_json.n_vertices(), result.n_vertices());
+  for (const VertexHandle v : result.vertices()) EXPECT_EQ(from_json.point(v), result.point(v));
   fs::remove(out);
   const CliRun refused = run(args + " --no-remesh");
   EXPECT_EQ(refused.exit_code, 1);
