@@ -28,7 +28,7 @@ std::string error_of(const json& j) {
 TEST(EditRequest, ParsesEveryRegionAndTransformForm) {
   const json j = json::parse(R"({
     "k": 3, "solver": "ldlt", "areas": "mixed-symmetric", "details": "none", "method": "nonlinear",
-    "energy": "blended-motions", "remesh": false,
+    "energy": "blended-motions", "remesh": false, "refine_support": true,
     "base_smoothing": 1.5, "base_feature_cap": 0.5,
     "support": {"union": [[1, 2, 3], {"box": {"min": [0, 0, 0], "max": [1, 1, 1]}},
                           {"geodesic": {"vertex": 5, "radius": 0.5}}]},
@@ -43,6 +43,10 @@ TEST(EditRequest, ParsesEveryRegionAndTransformForm) {
   EXPECT_EQ(*r.k, 3);
   EXPECT_EQ(*r.solver, "ldlt");
   EXPECT_FALSE(*r.remesh);
+  EXPECT_TRUE(*r.refine_support);
+  EXPECT_FALSE(
+      parse_edit_request({{"support", {1}}, {"handles", json::parse(R"([{"region": [1]}])")}})
+          .refine_support.has_value());
   EXPECT_EQ(r.support.kind, RegionSpec::Kind::Union);
   ASSERT_EQ(r.support.parts.size(), 3u);
   EXPECT_EQ(r.support.parts[2].vertex, 5);
@@ -77,6 +81,9 @@ TEST(EditRequest, ErrorsNameTheJsonPath) {
                 .find("unknown key 'colour'"),
             std::string::npos);
   EXPECT_NE(error_of({{"support", {1}}, {"handles", handles}, {"k", 4}}).find("edit.k"),
+            std::string::npos);
+  EXPECT_NE(error_of({{"support", {1}}, {"handles", handles}, {"refine_support", 1}})
+                .find("edit.refine_support: expected true or false"),
             std::string::npos);
   EXPECT_NE(error_of({{"support", {{"sphere", {{"center", {0, 0}}, {"radius", 1}}}}},
                       {"handles", handles}})

@@ -357,10 +357,11 @@ void run_edit(const EditArgs& a) {
   Selection s = select_regions(request, loaded, a.in);
   Mesh mesh = loaded.mesh;
   std::size_t refined = 0;
-  if (a.refine_support) {
+  if (a.refine_support || request.refine_support.value_or(false)) {
     if (!options.remesh)
-      throw InvalidArgument("--refine-support splits the support to the remeshed base's edge "
-                            "length; it does not combine with --no-remesh");
+      throw InvalidArgument("--refine-support (EDIT.json \"refine_support\") splits the support "
+                            "to the remeshed base's edge length; it does not combine with "
+                            "--no-remesh (\"remesh\": false)");
     // The base's edge length on the input as loaded, kept for the refined one.
     if (options.remesh_options.target_length <= 0.0)
       options.remesh_options.target_length =

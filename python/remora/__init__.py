@@ -11,7 +11,7 @@ package wraps Remora's C++ library (docs/python.md is the tutorial):
   filter :func:`low_pass`;
 - the editor (sections 3 and 6, Fig. 3): :class:`Editor`, :func:`transform`, and the region
   helpers :func:`select_sphere`, :func:`select_box`, :func:`select_geodesic_disc`,
-  :func:`nearest_vertex`;
+  :func:`nearest_vertex`, and :func:`refine_region` for a support of long triangles;
 - the mathematics (Eq. 1-3, section 5) as scipy.sparse matrices: :func:`cotan_laplacian`,
   :func:`mass_matrix`, :func:`kharmonic_system`.
 
@@ -26,6 +26,8 @@ from ._mesh import (
     nearest_vertex,
     quality,
     read_mesh,
+    refine_region,
+    Refined,
     repair,
     select_box,
     select_geodesic_disc,
@@ -42,6 +44,7 @@ __all__ = [
     "Editor",
     "KHarmonicSystem",
     "MeshData",
+    "Refined",
     "Remeshed",
     "SurfacePoints",
     "cotan_laplacian",
@@ -52,6 +55,7 @@ __all__ = [
     "nearest_vertex",
     "quality",
     "read_mesh",
+    "refine_region",
     "remesh",
     "repair",
     "select_box",

@@ -1,4 +1,4 @@
-"""Meshes in and out of files, the soup repair, the quality figures and vertex selections."""
+"""Meshes in and out of files, the soup repair, the quality figures, vertex selections, refinement."""
 
 import os
 from typing import NamedTuple
@@ -100,3 +100,33 @@ def select_geodesic_disc(V, F, seed: int, radius: float) -> np.ndarray:
 def nearest_vertex(V, point) -> int:
     """The id of the vertex nearest to ``point`` (the first of equals)."""
     return _remora.nearest_vertex(V, point)
+
+
+class Refined(NamedTuple):
+    """A mesh refined in a region: V, F as for :class:`MeshData`; ``region`` the region's vertex
+    ids after the refinement (int64, increasing: the old ones and the new); ``added`` the number
+    of new vertices, numbered after the old ones."""
+
+    V: np.ndarray
+    F: np.ndarray
+    region: np.ndarray
+    added: int
+
+
+def refine_region(V, F, region, max_length: float, max_vertices=None) -> Refined:
+    """Splits the region's edges longer than ``max_length`` at their midpoints, longest first.
+
+    What ``remora edit --refine-support`` does to a support of long CAD triangles before the
+    edit (docs/editing.md, "A support of long triangles"): only the input's vertices move, so a
+    long triangle stays flat; split to about the base's edge length it bends with the base. The
+    midpoints lie on their edges, so the surface, its creases and corners stay where they are;
+    the old vertices keep their ids and positions, faces with no edge in the region are kept.
+    A good ``max_length`` is the editor's base edge length,
+    ``Editor(V, F).report()["remesh"]["target_length"]``.
+
+    ``region``: vertex ids or a boolean mask. ``max_vertices``: None, or the most vertices the
+    result may have. Raises ValueError for an id out of range, a ``max_length`` that is not > 0 or
+    a result over ``max_vertices``.
+    """
+    V2, F2, ids, added = _remora.refine_region(V, F, region, max_length, max_vertices)
+    return Refined(V2, F2, ids, int(added))

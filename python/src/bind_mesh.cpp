@@ -1,7 +1,10 @@
-// Meshes in and out of files, the soup repair, the quality figures and the vertex selections
-// (mesh/io.h, mesh/repair.h, geometry/quality.h, geometry/selection.h). The Python package
+// Meshes in and out of files, the soup repair, the quality figures, the vertex selections and the
+// refinement of a region (mesh/io.h, mesh/repair.h, geometry/quality.h, geometry/selection.h,
+// mesh/refine.h). The Python package
 // (python/remora/) documents every function.
+#include <cmath>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -14,6 +17,7 @@
 #include "remora/geometry/quality.h"
 #include "remora/geometry/selection.h"
 #include "remora/mesh/io.h"
+#include "remora/mesh/refine.h"
 #include "remora/mesh/repair.h"
 
 namespace remora::python {
@@ -120,6 +124,27 @@ py::array_t<std::int64_t> geodesic_disc(const py::handle& vertices, const py::ha
   return ids_array(ids);
 }
 
+py::tuple refine(const py::handle& vertices, const py::handle& faces, const py::handle& region,
+                 const py::handle& max_length, const py::handle& max_vertices) {
+  Mesh mesh = mesh_arg(vertices, faces);
+  const std::vector<int> ids = indices_arg(region, "region", mesh.n_vertices(), true);
+  const double length = real_arg(max_length, "max_length");
+  if (!(length > 0)) throw InvalidArgument(fmt::format("max_length: must be > 0, not {}", length));
+  std::size_t limit = std::numeric_limits<std::size_t>::max();
+  if (!max_vertices.is_none()) {
+    const double wanted = real_arg(max_vertices, "max_vertices");
+    if (!(wanted >= 0) || wanted != std::floor(wanted))
+      throw InvalidArgument("max_vertices: expected a whole number >= 0, or None");
+    limit = static_cast<std::size_t>(wanted);
+  }
+  RefineResult r;
+  {
+    py::gil_scoped_release release;
+    r = refine_region(mesh, ids, length, limit);
+  }
+  return py::make_tuple(vertices_array(mesh), faces_array(mesh), ids_array(r.region), r.added);
+}
+
 int nearest(const py::handle& vertices, const py::handle& point) {
   const Mesh mesh = points_mesh_arg(vertices, "V");
   return nearest_vertex(mesh, vec3(vector3_arg(point, "point"))).idx();
@@ -137,6 +162,8 @@ void bind_mesh(py::module_& m) {
   m.def("select_geodesic_disc", &geodesic_disc, py::arg("V"), py::arg("F"), py::arg("seed"),
         py::arg("radius"));
   m.def("nearest_vertex", &nearest, py::arg("V"), py::arg("point"));
+  m.def("refine_region", &refine, py::arg("V"), py::arg("F"), py::arg("region"),
+        py::arg("max_length"), py::arg("max_vertices"));
   m.def("keep_freed_memory", &keep_freed_memory);
 }
 

@@ -97,3 +97,30 @@ def test_geodesic_disc_on_a_plane_is_round():
     assert set(np.flatnonzero(d < 0.28)) <= set(disc) <= set(np.flatnonzero(d <= 0.3 + 1e-9))
     with pytest.raises(ValueError, match="radius"):
         remora.select_geodesic_disc(V, F, seed, -1.0)
+
+
+def test_refine_region_splits_long_edges_on_the_surface():
+    # An octahedron's upper half refined to edges of at most 0.3: the old vertices stay, every
+    # new one lies on the surface (|x| + |y| + |z| = 1), the lower half is untouched, and every
+    # edge between two region vertices is at most 0.3 long; the lower apex stays out.
+    V, F = octahedron()
+    upper = [0, 1, 2, 3, 4]
+    r = remora.refine_region(V, F, upper, max_length=0.3)
+    assert r.added == len(r.V) - len(V) > 0
+    assert np.array_equal(r.V[: len(V)], V)
+    assert np.allclose(np.abs(r.V).sum(axis=1), 1.0)
+    assert set(range(len(V), len(r.V))) <= set(r.region.tolist())
+    assert 5 not in r.region
+    inside = np.zeros(len(r.V), bool)
+    inside[r.region] = True
+    for a, b in [(0, 1), (1, 2), (2, 0)]:
+        e = r.F[:, [a, b]]
+        both = inside[e[:, 0]] & inside[e[:, 1]]
+        lengths = np.linalg.norm(r.V[e[both, 0]] - r.V[e[both, 1]], axis=1)
+        assert lengths.max() <= 0.3 + 1e-12
+    with pytest.raises(ValueError, match="max_length"):
+        remora.refine_region(V, F, upper, max_length=0.0)
+    with pytest.raises(ValueError, match="would pass 10 vertices"):
+        remora.refine_region(V, F, upper, max_length=0.3, max_vertices=10)
+    with pytest.raises(ValueError, match="region"):
+        remora.refine_region(V, F, [0, 99], max_length=0.3)

@@ -183,8 +183,8 @@ TransformSpec parse_transform(const json& j, const std::string& path) {
 EditRequest parse_edit_request(const json& j) {
   EditRequest r;
   only_keys(j, "edit",
-            {"k", "solver", "areas", "details", "method", "energy", "remesh", "base_smoothing",
-             "base_feature_cap", "support", "handles"});
+            {"k", "solver", "areas", "details", "method", "energy", "remesh", "refine_support",
+             "base_smoothing", "base_feature_cap", "support", "handles"});
   if (j.contains("k")) {
     if (!j.at("k").is_number_integer()) fail("edit.k", "expected 1, 2 or 3");
     r.k = j.at("k").get<int>();
@@ -207,6 +207,10 @@ EditRequest parse_edit_request(const json& j) {
   if (j.contains("remesh")) {
     if (!j.at("remesh").is_boolean()) fail("edit.remesh", "expected true or false");
     r.remesh = j.at("remesh").get<bool>();
+  }
+  if (j.contains("refine_support")) {
+    if (!j.at("refine_support").is_boolean()) fail("edit.refine_support", "expected true or false");
+    r.refine_support = j.at("refine_support").get<bool>();
   }
   if (j.contains("base_smoothing")) {
     r.base_smoothing = number(j.at("base_smoothing"), "edit.base_smoothing");

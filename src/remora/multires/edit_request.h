@@ -2,7 +2,7 @@
 // format is documented with examples in docs/editing.md (a test runs those examples):
 //
 //   { "k": 2, "solver": "cholmod", "areas": "mean", "details": "normal", "method": "linear",
-//     "remesh": true,
+//     "remesh": true, "refine_support": false,
 //     "base_smoothing": 2.0, "base_feature_cap": 1.0,
 //     "support": <region>,
 //     "handles": [ { "region": <region>, "transform": <transform> }, ... ] }
@@ -60,6 +60,7 @@ struct EditRequest {
   std::optional<int> k;
   std::optional<std::string> solver, areas, details, method, energy;
   std::optional<bool> remesh;
+  std::optional<bool> refine_support; ///< the caller's: refine_region() before the editor
   std::optional<double> base_smoothing, base_feature_cap;
   RegionSpec support;
   std::vector<HandleSpec> handles;
