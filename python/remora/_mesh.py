@@ -121,8 +121,9 @@ def refine_region(V, F, region, max_length: float, max_vertices=None) -> Refined
     long triangle stays flat; split to about the base's edge length it bends with the base. The
     midpoints lie on their edges, so the surface, its creases and corners stay where they are;
     the old vertices keep their ids and positions, faces with no edge in the region are kept.
-    A good ``max_length`` is the editor's base edge length,
-    ``Editor(V, F).report()["remesh"]["target_length"]``.
+    A good ``max_length`` is the editor's base edge length L,
+    ``Editor(V, F).report()["base"]["target_length"]``; the refined mesh's editor,
+    ``Editor(r.V, r.F, remesh_options={"target_length": L})``, then has the same base.
 
     ``region``: vertex ids or a boolean mask. ``max_vertices``: None, or the most vertices the
     result may have. Raises ValueError for an id out of range, a ``max_length`` that is not > 0 or
