@@ -51,8 +51,8 @@ export async function api(path, options = {}) {
 }
 export const json = async (path, options) => (await api(path, options)).json();
 /// A response's body as one ArrayBuffer, read from its stream (into a buffer of its
-/// Content-Length when it has one): chromium hands over the bunny's 420 KB of positions about
-/// 2 ms sooner this way than through response.arrayBuffer() (docs/server.md).
+/// Content-Length when it has one): chromium hands over a binary answer sooner this way than
+/// through response.arrayBuffer() (docs/server.md, "Design notes on the drag's frames").
 export async function bodyBytes(response) {
   if (!response.body) return new ArrayBuffer(0); // 204, or a HEAD request
   const reader = response.body.getReader();
@@ -77,9 +77,9 @@ export const post = (path, body) => api(path, { method: 'POST', headers: { 'Cont
 
 /// Vertex ids (increasing; an array or a typed array) as POST /api/region takes them: {ranges: [[first, count], ...]}, runs
 /// of consecutive ids, when there are at most half as many runs as ids (a scan's or a subdivided
-/// mesh's vertex order keeps neighbours together: a 31k-vertex support of igea_sub4 is about 600
-/// runs), else the ids themselves. A smaller body travels faster: chromium takes far longer for a
-/// request body of 256 KB than of 128 KB.
+/// mesh's vertex order keeps neighbours together, so a support has far fewer runs than ids),
+/// else the ids themselves. A smaller body travels faster: chromium takes far longer for a
+/// request body of 256 KB than of 128 KB (docs/server.md, "What the page downloads").
 export function compactIds(ids) {
   const ranges = [];
   for (let i = 0; i < ids.length;) {

@@ -224,15 +224,15 @@ private:
     stats_ = SolverStats{};
   }
   // Coarser supernodes (set_supernodes) for one factor of up to kCoarseSupernodesRows rows (CHOLMOD
-  // pays its per-supernode costs there; the split halves keep the defaults). Merging
-  // more of them stores more explicit zeros, 28 % more at 479k rows for an 8 % faster factor, so
-  // larger systems keep the defaults and the region memory estimate of docs/limits.md
-  // (docs/solvers.md).
+  // pays its per-supernode costs there; the split halves keep the defaults). Merging stores
+  // explicit zeros, and on large systems the memory grows by much more than the factor speeds
+  // up, so larger systems keep the defaults, on whose fill the region memory estimate of
+  // docs/limits.md is sized (measurements: docs/solvers.md, "The factor of a region").
   static constexpr Eigen::Index kCoarseSupernodesRows = 200000;
   // Below this many flops (the analysis's estimate) the factor and its solves hold the BLAS at
-  // one thread (blas_threads.h): at 0.83 GFlop (the bunny's 30k-vertex thin plate) one thread
-  // is faster, and the editor's threads after it are not slowed; at 9.1 GFlop (igea_sub4's 119k)
-  // two threads factor 15 % faster (docs/solvers.md).
+  // one thread (blas_threads.h): there one thread is faster, and an idle second BLAS thread would
+  // spin and slow the editor's own threads after it; above it two threads factor faster
+  // (measurements: docs/solvers.md, "The factor of a region").
   static constexpr double kThreadedBlasFlops = 4e9;
   // Systems of kSplitRows rows or more are factored in two halves on two threads when a separator
   // of at most kMaxSeparatorRows rows balances them (split_cholesky.h, docs/solvers.md).

@@ -33,8 +33,8 @@ namespace remora {
 
 struct BakeOptions {
   /// Width of the filter's band around the moved input vertices, in σ. The filter's kernel
-  /// decays like exp(−d/σ): on the bunny the band's truncation was at most 2.3e-4, 3.8e-5,
-  /// 5.4e-6 and 8.2e-7 of the bounding-box diagonal at 2, 4, 6 and 8 σ (docs/editing.md).
+  /// decays like exp(−d/σ), so the band's truncation error falls by about e per σ of width
+  /// (measured against the whole mesh's filter: docs/editing.md, "Baking an edit").
   double margin = 6.0;
   /// A base edge whose length changed by more than this fraction makes its faces part of the
   /// patch that is remeshed again.

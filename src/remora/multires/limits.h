@@ -14,14 +14,15 @@ namespace remora {
 inline constexpr double kMemoryShare = 0.75;
 
 /// Peak resident memory of the editor's preprocessing per input triangle (loading, base surface,
-/// area-equalizing remesh, correspondence, and a small region), measured with `remora edit` on
-/// igea (269k triangles) and igea_sub4 (1.07M): 1.17-1.21 kB, linear in the mesh; with a margin.
+/// area-equalizing remesh, correspondence, and a small region), which is linear in the mesh: the
+/// peak measured with `remora edit`, with a margin (docs/limits.md, "How the defaults were
+/// chosen").
 inline constexpr std::uint64_t kEditorBytesPerTriangle = 1536;
 
 /// Memory of a region per free base vertex for k = 1, 2, 3 (index k - 1), with one handle: the
 /// sparse Cholesky factor (which grows a little faster than the region), the basis functions and
-/// the Phong details, measured with supports covering igea_sub4 (549k free base vertices); with a
-/// margin.
+/// the Phong details; measured with supports covering a whole mesh, with a margin that holds up
+/// to the mesh limit (docs/limits.md, "How the defaults were chosen").
 inline constexpr std::uint64_t kRegionBytesPerFreeVertex[3] = {2048, 4096, 8192};
 
 /// The memory each of `editors` editors alive at once may plan with: kMemoryShare of
@@ -29,8 +30,8 @@ inline constexpr std::uint64_t kRegionBytesPerFreeVertex[3] = {2048, 4096, 8192}
 std::uint64_t editor_memory_share(std::uint64_t memory_bytes, int editors = 1);
 
 /// What the mesh limit plans per triangle: the preprocessing and a region covering the whole mesh
-/// at k = 2 (0.51 free base vertices per input triangle on igea_sub4, at
-/// kRegionBytesPerFreeVertex[1] each).
+/// at k = 2 (a remeshed base has about half a free base vertex per input triangle, at
+/// kRegionBytesPerFreeVertex[1] each; docs/limits.md, "How the defaults were chosen").
 inline constexpr std::uint64_t kMeshBytesPerTriangle = kEditorBytesPerTriangle + 2048;
 
 /// The most triangles an editor fits in editor_memory_share() with a region over all of them at
@@ -48,8 +49,9 @@ inline constexpr std::uint64_t kWarmHeapBytes = std::uint64_t(256) << 20;
 std::uint64_t warm_heap_bytes(std::size_t base_vertices, int k);
 
 /// The handles an edit may have. Each handle adds four solutions to set_region and four columns
-/// per free vertex to the basis every frame blends (n_free x (3 + 4h) doubles): at 16 handles a
-/// region of 549k free base vertices (all of igea_sub4) holds a basis of 290 MB.
+/// per free vertex to the basis every frame blends (n_free x (3 + 4h) doubles): at 16 handles
+/// 536 bytes per free vertex (docs/limits.md, "How the defaults were chosen", has the basis of a
+/// region over a whole mesh).
 inline constexpr int kMaxHandles = 16;
 
 } // namespace remora
