@@ -29,6 +29,20 @@ inline Vec3 random_vector(std::mt19937& rng, double scale) {
   return Vec3(symmetric_unit(rng), symmetric_unit(rng), symmetric_unit(rng)) * scale;
 }
 
+/// Uniform in [0, 1).
+inline double unit(std::mt19937& rng) {
+  return static_cast<double>(rng()) / 4294967296.0;
+}
+
+/// A random direction times a length uniform in [0, max_length).
+inline Vec3 random_offset(std::mt19937& rng, double max_length) {
+  Vec3 d;
+  do {
+    d = random_vector(rng, 1.0);
+  } while (d.sqrnorm() > 1.0 || d.sqrnorm() < 1e-6);
+  return d.normalized() * (max_length * unit(rng));
+}
+
 /// The largest distance between corresponding rows of two n×3 matrices.
 /// Adds `other`'s vertices (moved by `offset`) and faces to `mesh`: a second component.
 inline void append_component(Mesh& mesh, const Mesh& other, const Vec3& offset) {
