@@ -121,8 +121,8 @@ std::unique_ptr<Factor> simplicial(const SparseMatrix& pattern, const SparseMatr
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   const auto* perm = static_cast<const int*>(out->f->Perm);
   out->position.resize(out->f->n);
-  for (std::size_t k = 0; k < out->f->n; ++k) out->position[static_cast<std::size_t>(perm[k])] =
-      static_cast<int>(k);
+  for (std::size_t k = 0; k < out->f->n; ++k)
+    out->position[static_cast<std::size_t>(perm[k])] = static_cast<int>(k);
   return out;
 }
 
@@ -216,8 +216,7 @@ void split_difference(const Grown& g, const std::vector<int>& position, Split& o
   const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(delta);
   const double floor = 1e-14 * eig.eigenvalues().cwiseAbs().maxCoeff();
   std::vector<Eigen::Index> pos, neg;
-  for (Eigen::Index k = 0; k < m; ++k)
-    (eig.eigenvalues()(k) > floor ? pos : neg).push_back(k);
+  for (Eigen::Index k = 0; k < m; ++k) (eig.eigenvalues()(k) > floor ? pos : neg).push_back(k);
   auto scaled = [&](const std::vector<Eigen::Index>& ks, double sign) {
     Eigen::MatrixXd c(m, static_cast<Eigen::Index>(ks.size()));
     for (std::size_t q = 0; q < ks.size(); ++q)

@@ -4,7 +4,9 @@
 // areas (SPD). `remora bench solvers` prints the same figures as a table next to the paper's,
 // with the iterative solvers and the multigrid; this file is for tracking the direct solvers'
 // costs over time, and what keeping a region's factor when a stroke grows the region would
-// give (grow_*). Results go to docs/benchmarks.md and docs/solvers.md with the machine.
+// give (grow_*; CHOLMOD's row addition, row deletion and update/downdate: bench_modify.cpp).
+// The regions are bench_regions.h's. Results go to docs/benchmarks.md and docs/solvers.md with
+// the machine.
 #include <algorithm>
 #include <map>
 #include <memory>
@@ -13,54 +15,15 @@
 #include <Eigen/Cholesky>
 #include <benchmark/benchmark.h>
 
-#include "remora/geometry/selection.h"
-#include "remora/linalg/kharmonic.h"
+#include "bench_regions.h"
 #include "remora/linalg/solver.h"
-#include "remora/mesh/io.h"
-#include "remora/remesh/remesh.h"
 
 namespace {
 
-using remora::KHarmonicSystem;
-
-struct Problem {
-  KHarmonicSystem system;
-  Eigen::MatrixXd rhs; ///< x, y, z of a handle translation
-};
-
-const remora::Mesh& remeshed_bunny() {
-  static const remora::Mesh mesh = [] {
-    remora::RemeshOptions options;
-    options.compute_report = false;
-    return remora::remesh(remora::read_mesh(std::string(REMORA_REPO_DATA) + "/bunny.ply").mesh,
-                          options)
-        .mesh;
-  }();
-  return mesh;
-}
-
-// The system with `free_count` free vertices, built once per size.
-const Problem& problem(int free_count) {
-  static std::map<int, std::unique_ptr<Problem>> cache;
-  auto& slot = cache[free_count];
-  if (slot) return *slot;
-  const remora::Mesh& mesh = remeshed_bunny();
-  const remora::VertexHandle seed = remora::central_vertex(mesh);
-  const auto handle = static_cast<std::size_t>(free_count) / 19; // 5 % of the disc
-  const std::vector<int> order =
-      remora::geodesic_order(mesh, seed, handle + static_cast<std::size_t>(free_count));
-  remora::Region region = remora::Region::all_fixed(mesh.n_vertices());
-  for (std::size_t i = 0; i < order.size(); ++i)
-    region.label[static_cast<std::size_t>(order[i])] = i < handle ? 0 : remora::Region::kFree;
-  slot = std::make_unique<Problem>();
-  slot->system = remora::assemble_kharmonic(mesh, region, {.k = 2});
-  Eigen::MatrixXd constrained = slot->system.gather_constrained(remora::positions_matrix(mesh));
-  for (std::size_t c = 0; c < slot->system.constrained_vertices.size(); ++c)
-    if (region.label[static_cast<std::size_t>(slot->system.constrained_vertices[c])] == 0)
-      constrained.row(static_cast<Eigen::Index>(c)) += Eigen::RowVector3d(0.01, 0.005, -0.008);
-  slot->rhs = slot->system.rhs(constrained);
-  return *slot;
-}
+using remora_bench::Grown;
+using remora_bench::grown;
+using remora_bench::Problem;
+using remora_bench::problem;
 
 remora::SolverOptions options_for(const std::string& name) {
   remora::SolverOptions options;
@@ -129,43 +92,10 @@ void basis_move(benchmark::State& state) {
   }
 }
 
-// A region grown by a stroke: the disc's 31,000 free vertices and then `added` more (the next
-// ones by distance, as a brush's crescent adds them). What the grown region's factor and 7
-// basis solves cost afresh, against keeping the old region's factor and bordering it with the
-// added rows: X = A_FF⁻¹ A_FA (one block solve of `added` columns), the Schur complement
-// S = A_AA − A_AF X (dense, Cholesky), and the grown system's solves by block elimination.
-// A principal submatrix: the grown region's rows and columns of F are the old system's.
-struct Grown {
-  const Problem* old = nullptr;
-  KHarmonicSystem system;
-  std::vector<Eigen::Index> old_rows, added_rows; ///< rows of the grown system: F's, the added
-  Eigen::MatrixXd rhs7;                           ///< 7 right-hand sides of the grown system
-};
-
-const Grown& grown(int added) {
-  static std::map<int, std::unique_ptr<Grown>> cache;
-  auto& slot = cache[added];
-  if (slot) return *slot;
-  constexpr int kFree = 31000;
-  slot = std::make_unique<Grown>();
-  slot->old = &problem(kFree);
-  const remora::Mesh& mesh = remeshed_bunny();
-  const auto handle = static_cast<std::size_t>(kFree) / 19;
-  const std::vector<int> order = remora::geodesic_order(
-      mesh, remora::central_vertex(mesh), handle + static_cast<std::size_t>(kFree + added));
-  remora::Region region = remora::Region::all_fixed(mesh.n_vertices());
-  for (std::size_t i = 0; i < order.size(); ++i)
-    region.label[static_cast<std::size_t>(order[i])] = i < handle ? 0 : remora::Region::kFree;
-  slot->system = remora::assemble_kharmonic(mesh, region, {.k = 2});
-  for (std::size_t r = 0; r < slot->system.free_vertices.size(); ++r) {
-    const int v = slot->system.free_vertices[r];
-    (slot->old->system.row_of[static_cast<std::size_t>(v)] >= 0 ? slot->old_rows : slot->added_rows)
-        .push_back(static_cast<Eigen::Index>(r));
-  }
-  slot->rhs7 = Eigen::MatrixXd::Random(slot->system.matrix.rows(), 7);
-  return *slot;
-}
-
+// What the grown region's factor and 7 basis solves cost afresh, against keeping the old
+// region's factor and bordering it with the added rows: X = A_FF⁻¹ A_FA (one block solve of
+// `added` columns), the Schur complement S = A_AA − A_AF X (dense, Cholesky), and the grown
+// system's solves by block elimination.
 void grow_afresh(benchmark::State& state) {
   const Grown& g = grown(static_cast<int>(state.range(0)));
   for (auto _ : state) {
