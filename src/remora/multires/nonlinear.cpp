@@ -249,7 +249,12 @@ struct NonlinearDeformer::Impl {
   }
 
   void build(const Mesh& base, const Eigen::MatrixXd& rest_positions);
+  void number_free_vertices();
+  void find_pivots(const Eigen::MatrixXd& rest_positions);
+  void find_cells(const Mesh& base);
   void read_rings(const Mesh& base, const Eigen::MatrixXd& rest_positions);
+  void factorize_global_matrix();
+  double mean_cell_edge_length() const;
   void update_constrained_rhs();
   double max_move(const Eigen::VectorXd& u, const Eigen::VectorXd& v) const {
     double worst = 0.0;
@@ -291,25 +296,10 @@ void NonlinearDeformer::Impl::read_rings(const Mesh& base, const Eigen::MatrixXd
 
 void NonlinearDeformer::Impl::build(const Mesh& base, const Eigen::MatrixXd& rest_positions) {
   n = base.n_vertices();
-  row_of.assign(n, -1);
-  for (std::size_t v = 0; v < n; ++v)
-    if (labels[v] == Region::kFree) {
-      row_of[v] = static_cast<int>(free_vertices.size());
-      free_vertices.push_back(static_cast<int>(v));
-    }
+  number_free_vertices();
   if (free_vertices.empty()) throw InvalidArgument("nonlinear deformer: no free vertex");
   if (blended) { // no system: the handles' pivots
-    const auto h = static_cast<std::size_t>(weights.cols());
-    pivots.assign(h, Vector3::Zero());
-    std::vector<double> count(h, 0.0);
-    for (std::size_t v = 0; v < n; ++v)
-      if (labels[v] >= 0 && static_cast<std::size_t>(labels[v]) < h) {
-        pivots[static_cast<std::size_t>(labels[v])] +=
-            rest_positions.row(static_cast<Eigen::Index>(v));
-        count[static_cast<std::size_t>(labels[v])] += 1.0;
-      }
-    for (std::size_t j = 0; j < h; ++j)
-      if (count[j] > 0.0) pivots[j] /= count[j];
+    find_pivots(rest_positions);
     rest = rest_positions;
     x = rest;
     return;
@@ -317,7 +307,46 @@ void NonlinearDeformer::Impl::build(const Mesh& base, const Eigen::MatrixXd& res
   // β = rigidity × (mean vertex area) / (the support's area) = rigidity / n_free: the two terms
   // keep their ratio when the base is refined or the shape scaled (docs/nonlinear.md).
   if (a > 0.0 && !propagated) beta = options.rigidity / static_cast<double>(free_vertices.size());
-  // The cells: the free vertices and their neighbours.
+  find_cells(base);
+  read_rings(base, rest_positions);
+  rest = rest_positions;
+  x = rest;
+  delta.resize(static_cast<Eigen::Index>(cells.size()), 3);
+  for (std::size_t c = 0; c < cells.size(); ++c)
+    delta.row(static_cast<Eigen::Index>(c)) = laplacian(rest, c).transpose();
+  stretch.assign(cells.size(), Matrix3::Identity());
+  rotation.assign(cells.size(), Matrix3::Identity());
+  factorize_global_matrix();
+  edge_length = mean_cell_edge_length();
+}
+
+// The free vertices in vertex order, and each vertex's row among them (row_of).
+void NonlinearDeformer::Impl::number_free_vertices() {
+  row_of.assign(n, -1);
+  for (std::size_t v = 0; v < n; ++v)
+    if (labels[v] == Region::kFree) {
+      row_of[v] = static_cast<int>(free_vertices.size());
+      free_vertices.push_back(static_cast<int>(v));
+    }
+}
+
+// BlendedMotions: each handle's pivot, the centroid of its vertices' rest positions.
+void NonlinearDeformer::Impl::find_pivots(const Eigen::MatrixXd& rest_positions) {
+  const auto h = static_cast<std::size_t>(weights.cols());
+  pivots.assign(h, Vector3::Zero());
+  std::vector<double> count(h, 0.0);
+  for (std::size_t v = 0; v < n; ++v)
+    if (labels[v] >= 0 && static_cast<std::size_t>(labels[v]) < h) {
+      pivots[static_cast<std::size_t>(labels[v])] +=
+          rest_positions.row(static_cast<Eigen::Index>(v));
+      count[static_cast<std::size_t>(labels[v])] += 1.0;
+    }
+  for (std::size_t j = 0; j < h; ++j)
+    if (count[j] > 0.0) pivots[j] /= count[j];
+}
+
+// The cells: the free vertices and their neighbours, in vertex order (cell_of: vertex -> cell).
+void NonlinearDeformer::Impl::find_cells(const Mesh& base) {
   std::vector<char> in_cell(n, 0);
   for (const int v : free_vertices) {
     in_cell[static_cast<std::size_t>(v)] = 1;
@@ -330,16 +359,10 @@ void NonlinearDeformer::Impl::build(const Mesh& base, const Eigen::MatrixXd& res
       cell_of[v] = static_cast<int>(cells.size());
       cells.push_back(static_cast<int>(v));
     }
-  read_rings(base, rest_positions);
-  rest = rest_positions;
-  x = rest;
-  delta.resize(static_cast<Eigen::Index>(cells.size()), 3);
-  for (std::size_t c = 0; c < cells.size(); ++c)
-    delta.row(static_cast<Eigen::Index>(c)) = laplacian(rest, c).transpose();
-  stretch.assign(cells.size(), Matrix3::Identity());
-  rotation.assign(cells.size(), Matrix3::Identity());
+}
 
-  // K = a (W²)_FF − 2β W_FF, from the cells' rows of W: (W²)_FF = W_CFᵀ W_CF.
+// K = a (W²)_FF − 2β W_FF, from the cells' rows of W: (W²)_FF = W_CFᵀ W_CF; factorized.
+void NonlinearDeformer::Impl::factorize_global_matrix() {
   const auto nfree = static_cast<Eigen::Index>(nf());
   std::vector<Eigen::Triplet<double>> cf, ff;
   for (std::size_t c = 0; c < cells.size(); ++c) {
@@ -369,8 +392,10 @@ void NonlinearDeformer::Impl::build(const Mesh& base, const Eigen::MatrixXd& res
   if (so.threads == 0) so.threads = options.threads;
   solver = make_solver(so);
   solver->compute(k);
+}
 
-  // The base's mean edge length over the cells (the tolerance's unit).
+// The base's mean edge length over the cells (the tolerance's unit); 1 without edges.
+double NonlinearDeformer::Impl::mean_cell_edge_length() const {
   double sum = 0.0;
   std::size_t count = 0;
   for (std::size_t c = 0; c < cells.size(); ++c)
@@ -378,7 +403,7 @@ void NonlinearDeformer::Impl::build(const Mesh& base, const Eigen::MatrixXd& res
       sum += (rest.row(cells[c]) - rest.row(ring_vertex[static_cast<std::size_t>(kk)])).norm();
       ++count;
     }
-  edge_length = count > 0 && sum > 0.0 ? sum / static_cast<double>(count) : 1.0;
+  return count > 0 && sum > 0.0 ? sum / static_cast<double>(count) : 1.0;
 }
 
 // −K_FC x_C = −a (W (W x̃))_F + 2β (W x̃)_F with x̃ the constrained values (free rows zero).
