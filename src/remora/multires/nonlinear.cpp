@@ -256,6 +256,9 @@ struct NonlinearDeformer::Impl {
   void factorize_global_matrix();
   double mean_cell_edge_length() const;
   void update_constrained_rhs();
+  void place_constrained(const std::vector<AffineMap>& transforms);
+  void blend_stretches(const std::vector<AffineMap>& transforms);
+  void choose_start(const RowPoints* guess);
   double max_move(const Eigen::VectorXd& u, const Eigen::VectorXd& v) const {
     double worst = 0.0;
     for (std::size_t r = 0; r < nf(); ++r)
@@ -486,6 +489,80 @@ void NonlinearDeformer::Impl::iterate() {
   stats.exhausted = !stats.converged && stats.total_iterations >= options.max_iterations;
 }
 
+// The constrained values: each handle vertex's rest position under its handle's transform.
+void NonlinearDeformer::Impl::place_constrained(const std::vector<AffineMap>& transforms) {
+  for (std::size_t v = 0; v < n; ++v) {
+    const int label = labels[v];
+    if (label >= 0) {
+      const AffineMap& t = transforms[static_cast<std::size_t>(label)];
+      x.row(static_cast<Eigen::Index>(v)) =
+          (t.leftCols<3>() * rest.row(static_cast<Eigen::Index>(v)).transpose() + t.col(3))
+              .transpose();
+    } // the fixed rows keep x⁰: nothing writes them
+  }
+}
+
+// Each cell's stretch: the handles' stretches blended by the handle weights.
+void NonlinearDeformer::Impl::blend_stretches(const std::vector<AffineMap>& transforms) {
+  const int handles = static_cast<int>(weights.cols());
+  std::vector<Matrix3> handle_stretch;
+  stretched = false;
+  for (const AffineMap& t : transforms) {
+    handle_stretch.push_back(polar_stretch(t.leftCols<3>()));
+    if (!(handle_stretch.back() - Matrix3::Identity()).isZero(1e-12)) stretched = true;
+  }
+  for (std::size_t c = 0; c < cells.size(); ++c) {
+    if (!stretched) {
+      stretch[c].setIdentity();
+      continue;
+    }
+    const auto v = static_cast<Eigen::Index>(cells[c]);
+    Matrix3 s = Matrix3::Zero();
+    double total = 0.0;
+    for (int j = 0; j < handles; ++j) {
+      const double w = weights(v, j);
+      s += w * handle_stretch[static_cast<std::size_t>(j)];
+      total += w;
+    }
+    stretch[c] = s + (1.0 - total) * Matrix3::Identity();
+  }
+}
+
+// Start from the lowest-energy of: the guess, and the current free positions moved as the
+// guess moved since the last call (a predictor along a drag); without a guess, the current
+// positions. Sets the rotations and the energy of the start.
+void NonlinearDeformer::Impl::choose_start(const RowPoints* guess) {
+  std::vector<Matrix3> rot(cells.size());
+  if (!guess) {
+    current_energy = local_step(rot);
+    rotation.swap(rot);
+    return;
+  }
+  Eigen::VectorXd g(static_cast<Eigen::Index>(3 * nf()));
+  for (std::size_t r = 0; r < nf(); ++r)
+    g.segment<3>(static_cast<Eigen::Index>(3 * r)) = guess->row(free_vertices[r]).transpose();
+  const Eigen::VectorXd current = free_vector();
+  const Eigen::VectorXd predictor = current + (g - previous_guess);
+  // Positions still at the last guess (nothing iterated since) make the predictor the guess.
+  const bool same = current == previous_guess;
+  current_energy = std::numeric_limits<double>::infinity();
+  Eigen::VectorXd best = g;
+  for (const Eigen::VectorXd* candidate : {&predictor, static_cast<const Eigen::VectorXd*>(&g)}) {
+    if (same && candidate == &predictor) continue;
+    set_free(*candidate);
+    const double e = local_step(rot);
+    if (e < current_energy) {
+      current_energy = e;
+      rotation.swap(rot);
+      best = *candidate;
+    }
+  }
+  set_free(best);
+  previous_guess = g;
+  if (!std::isfinite(current_energy))
+    throw NumericalError("nonlinear deformer: the start has a non-finite energy");
+}
+
 NonlinearDeformer::NonlinearDeformer(const Mesh& base, const Eigen::MatrixXd& rest,
                                      const std::vector<int>& labels,
                                      const Eigen::MatrixXd& handle_weights,
@@ -552,16 +629,7 @@ void NonlinearDeformer::set_transforms(const std::vector<AffineMap>& transforms,
     m.stats.energy.push_back(0.0);
     return;
   }
-  // Constrained values.
-  for (std::size_t v = 0; v < m.n; ++v) {
-    const int label = m.labels[v];
-    if (label >= 0) {
-      const AffineMap& t = transforms[static_cast<std::size_t>(label)];
-      m.x.row(static_cast<Eigen::Index>(v)) =
-          (t.leftCols<3>() * m.rest.row(static_cast<Eigen::Index>(v)).transpose() + t.col(3))
-              .transpose();
-    } // the fixed rows keep x⁰: nothing writes them
-  }
+  m.place_constrained(transforms);
   if (m.blended) { // closed form: the result, no iteration
     blend_motions(m.rest, m.weights, m.free_vertices, handle_motions(transforms, m.pivots), m.x,
                   m.options.threads);
@@ -569,28 +637,7 @@ void NonlinearDeformer::set_transforms(const std::vector<AffineMap>& transforms,
     m.stats.converged = true;
     return;
   }
-  // Stretches blended by the handle weights.
-  std::vector<Matrix3> handle_stretch;
-  m.stretched = false;
-  for (const AffineMap& t : transforms) {
-    handle_stretch.push_back(polar_stretch(t.leftCols<3>()));
-    if (!(handle_stretch.back() - Matrix3::Identity()).isZero(1e-12)) m.stretched = true;
-  }
-  for (std::size_t c = 0; c < m.cells.size(); ++c) {
-    if (!m.stretched) {
-      m.stretch[c].setIdentity();
-      continue;
-    }
-    const auto v = static_cast<Eigen::Index>(m.cells[c]);
-    Matrix3 s = Matrix3::Zero();
-    double total = 0.0;
-    for (int j = 0; j < handles; ++j) {
-      const double w = m.weights(v, j);
-      s += w * handle_stretch[static_cast<std::size_t>(j)];
-      total += w;
-    }
-    m.stretch[c] = s + (1.0 - total) * Matrix3::Identity();
-  }
+  m.blend_stretches(transforms);
   m.update_constrained_rhs();
   if (m.propagated) { // the rotations from the handles; the start is the guess
     m.propagate_rotations(transforms);
@@ -601,38 +648,7 @@ void NonlinearDeformer::set_transforms(const std::vector<AffineMap>& transforms,
     m.stats.converged = false;
     return;
   }
-  // Start from the lowest-energy of: the guess, and the current free positions moved as the
-  // guess moved since the last call (a predictor along a drag); without a guess, the current
-  // positions.
-  std::vector<Matrix3> rot(m.cells.size());
-  if (!guess) {
-    m.current_energy = m.local_step(rot);
-    m.rotation.swap(rot);
-  } else {
-    Eigen::VectorXd g(static_cast<Eigen::Index>(3 * m.nf()));
-    for (std::size_t r = 0; r < m.nf(); ++r)
-      g.segment<3>(static_cast<Eigen::Index>(3 * r)) = guess->row(m.free_vertices[r]).transpose();
-    const Eigen::VectorXd current = m.free_vector();
-    const Eigen::VectorXd predictor = current + (g - m.previous_guess);
-    // Positions still at the last guess (nothing iterated since) make the predictor the guess.
-    const bool same = current == m.previous_guess;
-    m.current_energy = std::numeric_limits<double>::infinity();
-    Eigen::VectorXd best = g;
-    for (const Eigen::VectorXd* candidate : {&predictor, static_cast<const Eigen::VectorXd*>(&g)}) {
-      if (same && candidate == &predictor) continue;
-      m.set_free(*candidate);
-      const double e = m.local_step(rot);
-      if (e < m.current_energy) {
-        m.current_energy = e;
-        m.rotation.swap(rot);
-        best = *candidate;
-      }
-    }
-    m.set_free(best);
-    m.previous_guess = g;
-    if (!std::isfinite(m.current_energy))
-      throw NumericalError("nonlinear deformer: the start has a non-finite energy");
-  }
+  m.choose_start(guess);
   m.stats.energy.push_back(m.current_energy);
   m.stats.converged = false;
 }
