@@ -69,52 +69,38 @@ void check_update_sizes(const Mesh& mesh, std::size_t previous_vertices,
                             " earlier vertices; mark it changed");
 }
 
-} // namespace
-
-KHarmonicAssembler::KHarmonicAssembler(const Mesh& mesh, const KHarmonicAssembler& previous,
-                                       const std::vector<int>& previous_of,
-                                       const std::vector<char>& changed, int threads)
-    : threads_(threads) {
-  check_update_sizes(mesh, previous.vertex_count(), previous_of, changed);
-  const std::size_t n = mesh.n_vertices();
-  const std::vector<char> dirty = reached(mesh, changed);
-  // Earlier vertex -> vertex, for the unchanged ones. The neighbours of a vertex that no changed
-  // vertex touches are unchanged (each shares a face with it), so its copy needs only these.
-  std::vector<int> current_of(previous.vertex_count(), -1);
-  for (std::size_t v = 0; v < n; ++v)
-    if (!changed[v]) current_of[static_cast<std::size_t>(previous_of[v])] = static_cast<int>(v);
-  std::atomic<bool> broken{false}; // a contract broken: no throw inside a parallel loop
-  const auto current = [&](int earlier) {
-    const int v = current_of[static_cast<std::size_t>(earlier)];
-    if (v < 0) broken = true;
+// The current vertex of each earlier vertex that an unchanged vertex was (-1: none). current()
+// of an earlier vertex without one gives 0 and records the broken contract: no throw inside a
+// parallel loop.
+class Renumbering {
+public:
+  Renumbering(const std::vector<int>& previous_of, const std::vector<char>& changed,
+              std::size_t previous_vertices)
+      : current_of_(previous_vertices, -1) {
+    for (std::size_t v = 0; v < changed.size(); ++v)
+      if (!changed[v]) current_of_[static_cast<std::size_t>(previous_of[v])] = static_cast<int>(v);
+  }
+  int current(int earlier) const {
+    const int v = current_of_[static_cast<std::size_t>(earlier)];
+    if (v < 0) broken_ = true;
     return std::max(v, 0);
-  };
+  }
+  bool broken() const { return broken_; }
 
-  // The areas, the one-rings and the components on another thread, −W here.
-  auto rest = std::async(threads == 1 ? std::launch::deferred : std::launch::async, [&] {
-    area_.resize(static_cast<Eigen::Index>(n));
-    offsets_.assign(n + 1, 0);
-    for (std::size_t v = 0; v < n; ++v) {
-      const VertexHandle vh(static_cast<int>(v));
-      if (dirty[v]) {
-        area_[static_cast<Eigen::Index>(v)] = vertex_area_mixed(mesh, vh);
-        for (const VertexHandle w : mesh.vv_range(vh)) adjacent_.push_back(w.idx());
-      } else {
-        const auto o = static_cast<std::size_t>(previous_of[v]);
-        area_[static_cast<Eigen::Index>(v)] = previous.area_[static_cast<Eigen::Index>(o)];
-        for (int a = previous.offsets_[o]; a < previous.offsets_[o + 1]; ++a)
-          adjacent_.push_back(current(previous.adjacent_[static_cast<std::size_t>(a)]));
-      }
-      offsets_[v + 1] = static_cast<int>(adjacent_.size());
-    }
-    inverse_areas();
-    find_components(mesh);
-  });
+private:
+  std::vector<int> current_of_;
+  mutable std::atomic<bool> broken_{false};
+};
 
-  const SparseMatrix& earlier = previous.minus_w_;
+// Sizes −W for `mesh` (n × n) and its column starts: a dirty column's entries counted on the
+// mesh, a copied one's taken from `earlier`.
+void size_columns(const Mesh& mesh, const std::vector<char>& dirty,
+                  const std::vector<int>& previous_of, const SparseMatrix& earlier, int threads,
+                  SparseMatrix& minus_w) {
+  const std::size_t n = mesh.n_vertices();
   const auto size = static_cast<Eigen::Index>(n);
-  minus_w_.resize(size, size);
-  int* outer = minus_w_.outerIndexPtr();
+  minus_w.resize(size, size);
+  int* outer = minus_w.outerIndexPtr();
   outer[0] = 0;
   parallel_for(n, threads, [&](std::size_t v) {
     int count = 0;
@@ -131,10 +117,43 @@ KHarmonicAssembler::KHarmonicAssembler(const Mesh& mesh, const KHarmonicAssemble
     outer[v + 1] = count;
   });
   for (std::size_t v = 0; v < n; ++v) outer[v + 1] += outer[v];
-  minus_w_.resizeNonZeros(outer[n]);
-  int* rows = minus_w_.innerIndexPtr();
-  double* values = minus_w_.valuePtr();
-  parallel_for(n, threads, [&](std::size_t v) {
+  minus_w.resizeNonZeros(outer[n]);
+}
+
+// Column o of `earlier` into rows/values from `at`, its rows renumbered; sorted again only where
+// the renumbering moved a neighbour past another (the splice moves the last vertices into the
+// places it frees). `entries`: scratch.
+void copy_column(const SparseMatrix& earlier, int o, const Renumbering& renumbering, std::size_t at,
+                 int* rows, double* values, std::vector<std::pair<int, double>>& entries) {
+  const int begin = earlier.outerIndexPtr()[o], end = earlier.outerIndexPtr()[o + 1];
+  bool sorted = true;
+  for (int k = begin; k < end; ++k) {
+    const std::size_t e = at + static_cast<std::size_t>(k - begin);
+    rows[e] = renumbering.current(earlier.innerIndexPtr()[k]);
+    values[e] = earlier.valuePtr()[k];
+    sorted = sorted && (k == begin || rows[e - 1] < rows[e]);
+  }
+  if (sorted) return;
+  entries.clear();
+  for (std::size_t e = at; e < at + static_cast<std::size_t>(end - begin); ++e)
+    entries.emplace_back(rows[e], values[e]);
+  std::sort(entries.begin(), entries.end(),
+            [](const auto& x, const auto& y) { return x.first < y.first; });
+  for (std::size_t k = 0; k < entries.size(); ++k) {
+    rows[at + k] = entries[k].first;
+    values[at + k] = entries[k].second;
+  }
+}
+
+// The entries of −W into the columns size_columns() made: a dirty column computed on the mesh,
+// a copied one from `earlier`.
+void fill_columns(const Mesh& mesh, const std::vector<char>& dirty,
+                  const std::vector<int>& previous_of, const SparseMatrix& earlier,
+                  const Renumbering& renumbering, int threads, SparseMatrix& minus_w) {
+  const int* outer = minus_w.outerIndexPtr();
+  int* rows = minus_w.innerIndexPtr();
+  double* values = minus_w.valuePtr();
+  parallel_for(mesh.n_vertices(), threads, [&](std::size_t v) {
     thread_local std::vector<std::pair<int, double>> entries;
     const auto at = static_cast<std::size_t>(outer[v]);
     if (dirty[v]) {
@@ -145,30 +164,48 @@ KHarmonicAssembler::KHarmonicAssembler(const Mesh& mesh, const KHarmonicAssemble
       }
       return;
     }
-    // The earlier column, its rows renumbered; sorted again only where the renumbering moved a
-    // neighbour past another (the splice moves the last vertices into the places it frees).
-    const int o = previous_of[v];
-    const int begin = earlier.outerIndexPtr()[o], end = earlier.outerIndexPtr()[o + 1];
-    bool sorted = true;
-    for (int k = begin; k < end; ++k) {
-      const std::size_t e = at + static_cast<std::size_t>(k - begin);
-      rows[e] = current(earlier.innerIndexPtr()[k]);
-      values[e] = earlier.valuePtr()[k];
-      sorted = sorted && (k == begin || rows[e - 1] < rows[e]);
-    }
-    if (sorted) return;
-    entries.clear();
-    for (std::size_t e = at; e < at + static_cast<std::size_t>(end - begin); ++e)
-      entries.emplace_back(rows[e], values[e]);
-    std::sort(entries.begin(), entries.end(),
-              [](const auto& x, const auto& y) { return x.first < y.first; });
-    for (std::size_t k = 0; k < entries.size(); ++k) {
-      rows[at + k] = entries[k].first;
-      values[at + k] = entries[k].second;
-    }
+    copy_column(earlier, previous_of[v], renumbering, at, rows, values, entries);
   });
+}
+
+} // namespace
+
+KHarmonicAssembler::KHarmonicAssembler(const Mesh& mesh, const KHarmonicAssembler& previous,
+                                       const std::vector<int>& previous_of,
+                                       const std::vector<char>& changed, int threads)
+    : threads_(threads) {
+  check_update_sizes(mesh, previous.vertex_count(), previous_of, changed);
+  const std::size_t n = mesh.n_vertices();
+  const std::vector<char> dirty = reached(mesh, changed);
+  // Earlier vertex -> vertex, for the unchanged ones. The neighbours of a vertex that no changed
+  // vertex touches are unchanged (each shares a face with it), so its copy needs only these.
+  const Renumbering renumbering(previous_of, changed, previous.vertex_count());
+
+  // The areas, the one-rings and the components on another thread, −W here.
+  auto rest = std::async(threads == 1 ? std::launch::deferred : std::launch::async, [&] {
+    area_.resize(static_cast<Eigen::Index>(n));
+    offsets_.assign(n + 1, 0);
+    for (std::size_t v = 0; v < n; ++v) {
+      const VertexHandle vh(static_cast<int>(v));
+      if (dirty[v]) {
+        area_[static_cast<Eigen::Index>(v)] = vertex_area_mixed(mesh, vh);
+        for (const VertexHandle w : mesh.vv_range(vh)) adjacent_.push_back(w.idx());
+      } else {
+        const auto o = static_cast<std::size_t>(previous_of[v]);
+        area_[static_cast<Eigen::Index>(v)] = previous.area_[static_cast<Eigen::Index>(o)];
+        for (int a = previous.offsets_[o]; a < previous.offsets_[o + 1]; ++a)
+          adjacent_.push_back(renumbering.current(previous.adjacent_[static_cast<std::size_t>(a)]));
+      }
+      offsets_[v + 1] = static_cast<int>(adjacent_.size());
+    }
+    inverse_areas();
+    find_components(mesh);
+  });
+
+  size_columns(mesh, dirty, previous_of, previous.minus_w_, threads, minus_w_);
+  fill_columns(mesh, dirty, previous_of, previous.minus_w_, renumbering, threads, minus_w_);
   rest.get();
-  if (broken)
+  if (renumbering.broken())
     throw Error("k-harmonic assembler update: a neighbour of an unchanged vertex has no vertex in "
                 "the new mesh; a vertex was marked unchanged though its faces changed");
 }
