@@ -169,52 +169,67 @@ void move_edge(Mesh& mesh, int from, int to) {
   }
 }
 
-} // namespace
+// Where the patch's elements go in the mesh.
+struct Placement {
+  std::vector<int> vertex_owner, edge_owner, face_owner; // per place: its element (places())
+  std::vector<int> new_vertices; // the patch's vertices without an origin, ascending
+  std::vector<int> vmap, emap;   // per patch vertex and edge: its place (-1: a boundary edge)
+  std::vector<int> fplace;       // per patch face: its place
+};
 
-SpliceMap splice(Mesh& mesh, const std::vector<char>& removed, const Mesh& patch,
-                 const std::vector<int>& origin) {
-  const Plan plan = plan_splice(mesh, removed, patch, origin);
-  const std::size_t old_vertices = mesh.n_vertices(), old_faces = mesh.n_faces();
-  std::vector<int> vertex_owner(mesh.n_vertices()), edge_owner(mesh.n_edges()),
-      face_owner(mesh.n_faces());
-  for (std::size_t i = 0; i < vertex_owner.size(); ++i) vertex_owner[i] = static_cast<int>(i);
-  for (std::size_t i = 0; i < edge_owner.size(); ++i) edge_owner[i] = static_cast<int>(i);
-  for (std::size_t i = 0; i < face_owner.size(); ++i) face_owner[i] = static_cast<int>(i);
+// Chooses the places of the patch's new vertices, inner edges and faces: the removed elements',
+// then new ones appended to `mesh`.
+Placement place_patch(Mesh& mesh, const Plan& plan, const Mesh& patch,
+                      const std::vector<int>& origin) {
+  Placement at;
+  at.vertex_owner.resize(mesh.n_vertices());
+  at.edge_owner.resize(mesh.n_edges());
+  at.face_owner.resize(mesh.n_faces());
+  for (std::size_t i = 0; i < at.vertex_owner.size(); ++i) at.vertex_owner[i] = static_cast<int>(i);
+  for (std::size_t i = 0; i < at.edge_owner.size(); ++i) at.edge_owner[i] = static_cast<int>(i);
+  for (std::size_t i = 0; i < at.face_owner.size(); ++i) at.face_owner[i] = static_cast<int>(i);
   // Places for the patch's new vertices, inner edges and faces.
-  std::vector<int> new_vertices, inner_edges;
+  std::vector<int> inner_edges;
   for (const VertexHandle v : patch.vertices())
-    if (origin[static_cast<std::size_t>(v.idx())] < 0) new_vertices.push_back(v.idx());
+    if (origin[static_cast<std::size_t>(v.idx())] < 0) at.new_vertices.push_back(v.idx());
   for (const EdgeHandle e : patch.edges())
     if (!patch.is_boundary(e)) inner_edges.push_back(e.idx());
   const std::vector<int> vplace = places(
-      plan.vertices, new_vertices.size(), [&] { return mesh.new_vertex(Vec3(0, 0, 0)).idx(); },
-      vertex_owner);
+      plan.vertices, at.new_vertices.size(), [&] { return mesh.new_vertex(Vec3(0, 0, 0)).idx(); },
+      at.vertex_owner);
   const std::vector<int> eplace = places(
       plan.edges, inner_edges.size(),
-      [&] { return mesh.new_edge(VertexHandle(0), VertexHandle(0)).idx() / 2; }, edge_owner);
-  const std::vector<int> fplace = places(
-      plan.faces, patch.n_faces(), [&] { return mesh.new_face().idx(); }, face_owner);
+      [&] { return mesh.new_edge(VertexHandle(0), VertexHandle(0)).idx() / 2; }, at.edge_owner);
+  at.fplace = places(
+      plan.faces, patch.n_faces(), [&] { return mesh.new_face().idx(); }, at.face_owner);
   // The patch's elements in the mesh's numbering.
-  std::vector<int> vmap(patch.n_vertices()), emap(patch.n_edges(), -1);
-  for (std::size_t i = 0; i < origin.size(); ++i) vmap[i] = origin[i];
-  for (std::size_t i = 0; i < new_vertices.size(); ++i)
-    vmap[static_cast<std::size_t>(new_vertices[i])] = vplace[i];
+  at.vmap.resize(patch.n_vertices());
+  at.emap.assign(patch.n_edges(), -1);
+  for (std::size_t i = 0; i < origin.size(); ++i) at.vmap[i] = origin[i];
+  for (std::size_t i = 0; i < at.new_vertices.size(); ++i)
+    at.vmap[static_cast<std::size_t>(at.new_vertices[i])] = vplace[i];
   for (std::size_t i = 0; i < inner_edges.size(); ++i)
-    emap[static_cast<std::size_t>(inner_edges[i])] = eplace[i];
+    at.emap[static_cast<std::size_t>(inner_edges[i])] = eplace[i];
+  return at;
+}
+
+// Writes the patch's half-edge structure into its places; the boundary side of its border keeps
+// the mesh's own.
+void write_patch(Mesh& mesh, const Plan& plan, const Mesh& patch, const std::vector<int>& origin,
+                 const Placement& at) {
   auto hmap = [&](HalfedgeHandle h) {
     const auto e = static_cast<std::size_t>(h.idx() / 2);
-    if (emap[e] >= 0) return HalfedgeHandle(2 * emap[e] + (h.idx() & 1));
+    if (at.emap[e] >= 0) return HalfedgeHandle(2 * at.emap[e] + (h.idx() & 1));
     const HalfedgeHandle inner = plan.matched[e];
     return patch.is_boundary(h) ? mesh.opposite_halfedge_handle(inner) : inner;
   };
-  // The patch's half-edge structure; the boundary side of its border keeps the mesh's own.
   for (const HalfedgeHandle h : patch.halfedges()) {
     if (patch.is_boundary(h)) continue;
     const HalfedgeHandle g = hmap(h);
     mesh.set_vertex_handle(
-        g, VertexHandle(vmap[static_cast<std::size_t>(patch.to_vertex_handle(h).idx())]));
-    mesh.set_face_handle(g,
-                         FaceHandle(fplace[static_cast<std::size_t>(patch.face_handle(h).idx())]));
+        g, VertexHandle(at.vmap[static_cast<std::size_t>(patch.to_vertex_handle(h).idx())]));
+    mesh.set_face_handle(
+        g, FaceHandle(at.fplace[static_cast<std::size_t>(patch.face_handle(h).idx())]));
     mesh.status(g) = OpenMesh::Attributes::StatusInfo();
     mesh.status(mesh.edge_handle(g)) = OpenMesh::Attributes::StatusInfo();
   }
@@ -222,12 +237,12 @@ SpliceMap splice(Mesh& mesh, const std::vector<char>& removed, const Mesh& patch
     if (!patch.is_boundary(h))
       mesh.set_next_halfedge_handle(hmap(h), hmap(patch.next_halfedge_handle(h)));
   for (const FaceHandle f : patch.faces()) {
-    const FaceHandle g(fplace[static_cast<std::size_t>(f.idx())]);
+    const FaceHandle g(at.fplace[static_cast<std::size_t>(f.idx())]);
     mesh.set_halfedge_handle(g, hmap(patch.halfedge_handle(f)));
     mesh.status(g) = OpenMesh::Attributes::StatusInfo();
   }
   for (const VertexHandle v : patch.vertices()) {
-    const VertexHandle w(vmap[static_cast<std::size_t>(v.idx())]);
+    const VertexHandle w(at.vmap[static_cast<std::size_t>(v.idx())]);
     if (origin[static_cast<std::size_t>(v.idx())] < 0) {
       mesh.set_point(w, patch.point(v));
       mesh.status(w) = OpenMesh::Attributes::StatusInfo();
@@ -238,35 +253,52 @@ SpliceMap splice(Mesh& mesh, const std::vector<char>& removed, const Mesh& patch
         mesh.set_halfedge_handle(w, hmap(patch.halfedge_handle(v)));
     }
   }
-  // Places left over: the last elements move in.
-  const int nv = close_gaps(vertex_owner, [&](int a, int b) { move_vertex(mesh, a, b); });
-  const int ne = close_gaps(edge_owner, [&](int a, int b) { move_edge(mesh, a, b); });
-  const int nf = close_gaps(face_owner, [&](int a, int b) { move_face(mesh, a, b); });
-  mesh.resize(static_cast<std::size_t>(nv), static_cast<std::size_t>(ne),
-              static_cast<std::size_t>(nf));
+}
+
+// The new numbers of the mesh's and the patch's vertices and faces, from the owners of the first
+// nv vertex and nf face places once close_gaps() has run.
+SpliceMap splice_map(std::size_t old_vertices, std::size_t old_faces, const Mesh& patch,
+                     const std::vector<int>& origin, const Placement& at, int nv, int nf) {
   SpliceMap map;
   map.vertices.assign(old_vertices, -1);
   map.faces.assign(old_faces, -1);
   map.patch_vertices.assign(patch.n_vertices(), -1);
   map.patch_faces.assign(patch.n_faces(), -1);
   for (int i = 0; i < nv; ++i) {
-    const int o = vertex_owner[static_cast<std::size_t>(i)];
+    const int o = at.vertex_owner[static_cast<std::size_t>(i)];
     if (o >= 0)
       map.vertices[static_cast<std::size_t>(o)] = i;
     else
-      map.patch_vertices[static_cast<std::size_t>(new_vertices[static_cast<std::size_t>(-2 - o)])] =
-          i;
+      map.patch_vertices[static_cast<std::size_t>(
+          at.new_vertices[static_cast<std::size_t>(-2 - o)])] = i;
   }
   for (std::size_t v = 0; v < origin.size(); ++v)
     if (origin[v] >= 0) map.patch_vertices[v] = map.vertices[static_cast<std::size_t>(origin[v])];
   for (int i = 0; i < nf; ++i) {
-    const int o = face_owner[static_cast<std::size_t>(i)];
+    const int o = at.face_owner[static_cast<std::size_t>(i)];
     if (o >= 0)
       map.faces[static_cast<std::size_t>(o)] = i;
     else
       map.patch_faces[static_cast<std::size_t>(-2 - o)] = i;
   }
   return map;
+}
+
+} // namespace
+
+SpliceMap splice(Mesh& mesh, const std::vector<char>& removed, const Mesh& patch,
+                 const std::vector<int>& origin) {
+  const Plan plan = plan_splice(mesh, removed, patch, origin);
+  const std::size_t old_vertices = mesh.n_vertices(), old_faces = mesh.n_faces();
+  Placement at = place_patch(mesh, plan, patch, origin);
+  write_patch(mesh, plan, patch, origin, at);
+  // Places left over: the last elements move in.
+  const int nv = close_gaps(at.vertex_owner, [&](int a, int b) { move_vertex(mesh, a, b); });
+  const int ne = close_gaps(at.edge_owner, [&](int a, int b) { move_edge(mesh, a, b); });
+  const int nf = close_gaps(at.face_owner, [&](int a, int b) { move_face(mesh, a, b); });
+  mesh.resize(static_cast<std::size_t>(nv), static_cast<std::size_t>(ne),
+              static_cast<std::size_t>(nf));
+  return splice_map(old_vertices, old_faces, patch, origin, at, nv, nf);
 }
 
 } // namespace remora
