@@ -94,47 +94,14 @@ Editor::Editor(Mesh mesh, EditorOptions options) : impl_(std::make_unique<Impl>(
   // 2. The base surface S: low-pass filtered O, same connectivity.
   m.progress("base surface", 0, 1);
   auto t0 = Clock::now();
-  LowPassOptions filter_options = m.options.base;
-  if (filter_options.threads == 0) filter_options.threads = m.options.threads;
-  m.filter = std::make_shared<const LowPassFilter>(m.input, filter_options);
-  m.smooth = m.filter->apply(m.input_positions);
-  m.report.sigma = m.filter->stats().sigma;
-  m.report.sigma_min = m.filter->stats().sigma_min;
-  m.report.sigma_capped_vertices = m.filter->stats().capped;
-  m.report.sigma_capped_loops = m.filter->stats().capped_loops;
-  m.report.intrinsic_flips = m.filter->stats().laplacian_stats.flips;
-  m.report.input_negative_weights = m.filter->stats().laplacian_stats.negative_before;
+  m.filter_input();
   Mesh s = m.input;
   set_positions(s, m.smooth);
   m.report.milliseconds["base"] = ms_since(t0);
 
   // 3. The base B: the area-equalizing remesh of S, with the correspondence.
   t0 = Clock::now();
-  if (m.options.remesh) {
-    RemeshOptions ro = m.options.remesh_options;
-    ro.threads = m.options.threads;
-    ro.progress = [&m](std::string_view phase, int step, int steps) {
-      m.progress(fmt::format("remesh: {}", phase), step, steps);
-    };
-    RemeshResult r = remesh(s, ro);
-    m.report.base_target_length = r.report.target_length;
-    m.base = std::move(r.mesh);
-    m.base_on_input = std::move(r.output_on_input);
-    m.input_on_base = std::move(r.input_on_output);
-  } else {
-    m.base = std::move(s);
-    m.base_on_input.assign(m.base.n_vertices(), SurfacePoint{FaceHandle(), {1.0, 0.0, 0.0}});
-    for (std::size_t f = 0; f < m.input_topology.faces.size(); ++f)
-      for (int k = 0; k < 3; ++k) {
-        SurfacePoint& sp = m.base_on_input[static_cast<std::size_t>(
-            m.input_topology.faces[f][static_cast<std::size_t>(k)])];
-        if (sp.face.is_valid()) continue;
-        sp.face = FaceHandle(static_cast<int>(f));
-        sp.bary = {0.0, 0.0, 0.0};
-        sp.bary[static_cast<std::size_t>(k)] = 1.0;
-      }
-    m.input_on_base = m.base_on_input;
-  }
+  m.make_base(s);
   m.topology = triangle_topology(m.base);
   m.base_rest = positions_matrix(m.base);
   m.base_normals = vertex_normals(m.topology, m.base_rest);
@@ -143,17 +110,67 @@ Editor::Editor(Mesh mesh, EditorOptions options) : impl_(std::make_unique<Impl>(
   m.report.base_faces = m.base.n_faces();
 
   t0 = Clock::now();
-  m.assembler.emplace(m.base, m.options.threads);
-  const SparseMatrix& minus_w = m.assembler->minus_w();
+  m.analyze_base();
+  m.report.milliseconds["base report"] = ms_since(t0);
+}
+
+// O's low-pass filter (options.base), S = filter(O) into `smooth`, and the filter's figures.
+void Editor::Impl::filter_input() {
+  LowPassOptions filter_options = options.base;
+  if (filter_options.threads == 0) filter_options.threads = options.threads;
+  filter = std::make_shared<const LowPassFilter>(input, filter_options);
+  smooth = filter->apply(input_positions);
+  report.sigma = filter->stats().sigma;
+  report.sigma_min = filter->stats().sigma_min;
+  report.sigma_capped_vertices = filter->stats().capped;
+  report.sigma_capped_loops = filter->stats().capped_loops;
+  report.intrinsic_flips = filter->stats().laplacian_stats.flips;
+  report.input_negative_weights = filter->stats().laplacian_stats.negative_before;
+}
+
+// B and the correspondence both ways: S remeshed, or, without remeshing, S itself (moved out of
+// `s`), each vertex located at its corner of the first input face that has it.
+void Editor::Impl::make_base(Mesh& s) {
+  if (options.remesh) {
+    RemeshOptions ro = options.remesh_options;
+    ro.threads = options.threads;
+    ro.progress = [this](std::string_view phase, int step, int steps) {
+      progress(fmt::format("remesh: {}", phase), step, steps);
+    };
+    RemeshResult r = remesh(s, ro);
+    report.base_target_length = r.report.target_length;
+    base = std::move(r.mesh);
+    base_on_input = std::move(r.output_on_input);
+    input_on_base = std::move(r.input_on_output);
+  } else {
+    base = std::move(s);
+    base_on_input.assign(base.n_vertices(), SurfacePoint{FaceHandle(), {1.0, 0.0, 0.0}});
+    for (std::size_t f = 0; f < input_topology.faces.size(); ++f)
+      for (int k = 0; k < 3; ++k) {
+        SurfacePoint& sp = base_on_input[static_cast<std::size_t>(
+            input_topology.faces[f][static_cast<std::size_t>(k)])];
+        if (sp.face.is_valid()) continue;
+        sp.face = FaceHandle(static_cast<int>(f));
+        sp.bary = {0.0, 0.0, 0.0};
+        sp.bary[static_cast<std::size_t>(k)] = 1.0;
+      }
+    input_on_base = base_on_input;
+  }
+}
+
+// B's Laplacian assembler, its edges with a negative cotan weight, its figures for the report
+// and the index of the base vertices by their nearest input vertex.
+void Editor::Impl::analyze_base() {
+  assembler.emplace(base, options.threads);
+  const SparseMatrix& minus_w = assembler->minus_w();
   for (Eigen::Index c = 0; c < minus_w.outerSize(); ++c)
     for (SparseMatrix::InnerIterator it(minus_w, c); it; ++it)
       if (it.row() < it.col() && it.value() > 0.0)
-        m.negative_edges.emplace_back(static_cast<int>(it.row()), static_cast<int>(it.col()));
-  m.report.base_symmetry_defect = laplacian_symmetry_defect(m.base);
-  m.report.base_quality = mesh_quality(m.base);
-  m.statistics = base_statistics(m.base);
-  m.index_base_nearest();
-  m.report.milliseconds["base report"] = ms_since(t0);
+        negative_edges.emplace_back(static_cast<int>(it.row()), static_cast<int>(it.col()));
+  report.base_symmetry_defect = laplacian_symmetry_defect(base);
+  report.base_quality = mesh_quality(base);
+  statistics = base_statistics(base);
+  index_base_nearest();
 }
 
 Editor::Editor(const std::function<void(EditorParts&)>& build, EditorOptions options)

@@ -88,6 +88,11 @@ struct Editor::Impl : EditorParts {
   std::deque<std::unique_ptr<RegionState>> recent;
   static constexpr std::size_t kRecentRegions = 2;
 
+  // The steps of Editor(mesh, options) after the input's checks, in order.
+  void filter_input();
+  void make_base(Mesh& s);
+  void analyze_base();
+
   void progress(std::string_view phase, int step, int steps) const {
     if (options.progress) options.progress(phase, step, steps);
   }
