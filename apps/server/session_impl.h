@@ -154,6 +154,14 @@ struct Session::Impl {
   /// longer busy (`finishing`).
   void region_job(const RegionKey& key, RegionWork work, const std::shared_ptr<EditorBox>& current,
                   const std::vector<Transform>& moved_by, const std::stop_token& token);
+  /// region_job()'s install, under the lock: `next` with `prepared` (when set) and `key` become
+  /// the session's editor and region; returns the nonlinear state left to build (or none).
+  Editor::NonlinearBuild make_current(const std::shared_ptr<EditorBox>& next, const RegionKey& key,
+                                      std::optional<Editor::Prepared>& prepared, bool resolve,
+                                      const std::vector<Transform>& moved_by);
+  /// region_job()'s end: `build` run with the lock released, then handed to `editor`.
+  void build_nonlinear(Editor& editor, Editor::NonlinearBuild& build, const std::stop_token& token,
+                       std::unique_lock<std::mutex>& lock);
   /// positions(budget) of the editor, as the answer to a move or a relax step. Under the lock.
   Frame frame(double budget_ms, FrameAnswer answer = FrameAnswer::Positions,
               const std::function<bool()>& interrupt = {});

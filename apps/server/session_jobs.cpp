@@ -179,11 +179,25 @@ void Session::Impl::region_job(const RegionKey& key, RegionWork work,
     restore();
     return;
   }
+  Editor::NonlinearBuild build = make_current(next, key, prepared, work.resolve, moved_by);
+  push_snapshot();
+  if (build.empty()) return;
+  build_nonlinear(editor, build, token, lock);
+}
+
+/// region_job()'s install, under the lock: `next` with `prepared` (when set) and `key` become the
+/// session's editor and region; returns the nonlinear state left to build (or none).
+Editor::NonlinearBuild Session::Impl::make_current(const std::shared_ptr<EditorBox>& next,
+                                                   const RegionKey& key,
+                                                   std::optional<Editor::Prepared>& prepared,
+                                                   bool resolve,
+                                                   const std::vector<Transform>& moved_by) {
+  Editor& editor = next->editor;
   // Method nonlinear: a new region is shown first, its nonlinear state built after.
   Editor::NonlinearBuild build;
   if (prepared) {
     editor.install_region(std::move(*prepared));
-    if (!work.resolve) build = editor.nonlinear_build();
+    if (!resolve) build = editor.nonlinear_build();
   }
   next->region = key;
   box = next;
@@ -191,7 +205,7 @@ void Session::Impl::region_job(const RegionKey& key, RegionWork work,
   baked.reset();
   baked_from.reset();
   ++region_id;
-  if (work.resolve) {
+  if (resolve) {
     for (std::size_t j = 0; j < moved_by.size(); ++j)
       box->editor.set_transform(static_cast<int>(j), moved_by[j]);
     shape->set_positions(box->editor.positions());
@@ -207,8 +221,13 @@ void Session::Impl::region_job(const RegionKey& key, RegionWork work,
       shape_behind = false;
     }
   }
-  push_snapshot();
-  if (build.empty()) return;
+  return build;
+}
+
+/// region_job()'s end: `build` run with the lock released, then handed to `editor`.
+void Session::Impl::build_nonlinear(Editor& editor, Editor::NonlinearBuild& build,
+                                    const std::stop_token& token,
+                                    std::unique_lock<std::mutex>& lock) {
   // The region is shown (no longer busy); its nonlinear state is built without the lock.
   finishing = true;
   busy = false;
