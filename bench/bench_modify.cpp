@@ -31,6 +31,8 @@
 #ifdef REMORA_WITH_GPL_SOLVERS
 #include <cholmod.h>
 
+#include "remora/linalg/cholmod_settings.h"
+
 namespace {
 
 using remora::SparseMatrix;
@@ -60,27 +62,17 @@ void check(bool ok, const char* what) {
   if (!ok || cm().c.status < CHOLMOD_OK) throw std::runtime_error(std::string(what) + " failed");
 }
 
-// The lower triangle of `a` as a CHOLMOD matrix (stype −1); the caller frees it.
-cholmod_sparse* lower_of(const SparseMatrix& a) {
-  std::size_t nnz = 0;
-  for (Eigen::Index j = 0; j < a.outerSize(); ++j)
-    for (SparseMatrix::InnerIterator it(a, j); it; ++it) nnz += it.row() >= j ? 1 : 0;
-  const auto n = static_cast<std::size_t>(a.rows());
-  cholmod_sparse* s = cholmod_allocate_sparse(n, n, nnz, 1, 1, -1, CHOLMOD_REAL, &cm().c);
-  auto* p = static_cast<int*>(s->p);
-  auto* i = static_cast<int*>(s->i);
-  auto* x = static_cast<double*>(s->x);
-  int k = 0;
-  for (Eigen::Index j = 0; j < a.outerSize(); ++j) {
-    p[j] = k;
-    for (SparseMatrix::InnerIterator it(a, j); it; ++it)
-      if (it.row() >= j) {
-        i[k] = static_cast<int>(it.row());
-        x[k++] = it.value();
-      }
-  }
-  p[a.outerSize()] = k;
-  return s;
+// The lower triangle of `a`, compressed: what lower_view() shows CHOLMOD.
+SparseMatrix lower_of(const SparseMatrix& a) {
+  SparseMatrix l = a.triangularView<Eigen::Lower>();
+  l.makeCompressed();
+  return l;
+}
+
+cholmod_sparse view_of(SparseMatrix& l) {
+  return remora::lower_view(static_cast<std::size_t>(l.rows()),
+                            static_cast<std::size_t>(l.nonZeros()), l.outerIndexPtr(),
+                            l.innerIndexPtr(), l.valuePtr());
 }
 
 // `a` with the rows and columns in `rows` replaced by the identity's.
@@ -110,13 +102,11 @@ struct Factor {
 std::unique_ptr<Factor> simplicial(const SparseMatrix& pattern, const SparseMatrix& values) {
   auto out = std::make_unique<Factor>();
   const auto t0 = std::chrono::steady_clock::now();
-  cholmod_sparse* p = lower_of(pattern);
-  cholmod_sparse* v = lower_of(values);
-  out->f = cholmod_analyze(p, &cm().c);
+  SparseMatrix lp = lower_of(pattern), lv = lower_of(values);
+  cholmod_sparse p = view_of(lp), v = view_of(lv);
+  out->f = cholmod_analyze(&p, &cm().c);
   check(out->f != nullptr, "cholmod_analyze");
-  check(cholmod_factorize(v, out->f, &cm().c) != 0, "cholmod_factorize");
-  cholmod_free_sparse(&p, &cm().c);
-  cholmod_free_sparse(&v, &cm().c);
+  check(cholmod_factorize(&v, out->f, &cm().c) != 0, "cholmod_factorize");
   out->factor_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   const auto* perm = static_cast<const int*>(out->f->Perm);
@@ -127,14 +117,8 @@ std::unique_ptr<Factor> simplicial(const SparseMatrix& pattern, const SparseMatr
 }
 
 Eigen::MatrixXd solve(cholmod_factor* f, const Eigen::MatrixXd& rhs) {
-  cholmod_dense b{};
-  b.nrow = static_cast<std::size_t>(rhs.rows());
-  b.ncol = static_cast<std::size_t>(rhs.cols());
-  b.nzmax = b.nrow * b.ncol;
-  b.d = b.nrow;
-  b.x = const_cast<double*>(rhs.data());
-  b.xtype = CHOLMOD_REAL;
-  b.dtype = CHOLMOD_DOUBLE;
+  cholmod_dense b = remora::dense_view(rhs.data(), static_cast<std::size_t>(rhs.rows()),
+                                       static_cast<std::size_t>(rhs.cols()));
   cholmod_dense* x = cholmod_solve(CHOLMOD_A, f, &b, &cm().c);
   check(x != nullptr, "cholmod_solve");
   Eigen::MatrixXd out =
@@ -172,17 +156,10 @@ struct Split {
 
 cholmod_sparse* columns(const Eigen::MatrixXd& v, const std::vector<Eigen::Index>& rows,
                         const std::vector<int>& position, std::size_t n) {
-  cholmod_dense d{};
   Eigen::MatrixXd full = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(n), v.cols());
   for (std::size_t t = 0; t < rows.size(); ++t)
     full.row(position[static_cast<std::size_t>(rows[t])]) = v.row(static_cast<Eigen::Index>(t));
-  d.nrow = n;
-  d.ncol = static_cast<std::size_t>(v.cols());
-  d.nzmax = d.nrow * d.ncol;
-  d.d = n;
-  d.x = full.data();
-  d.xtype = CHOLMOD_REAL;
-  d.dtype = CHOLMOD_DOUBLE;
+  cholmod_dense d = remora::dense_view(full.data(), n, static_cast<std::size_t>(v.cols()));
   cholmod_sparse* s = cholmod_dense_to_sparse(&d, 1, &cm().c);
   check(s != nullptr, "cholmod_dense_to_sparse");
   return s;
